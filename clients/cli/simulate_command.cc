@@ -1,0 +1,152 @@
+#include "simulate_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <stdexcept>
+
+#include "calib/frame_csv.h"
+#include "calib/replay.h"
+#include "demo_session.h"
+#include "progress.h"
+
+namespace hj::cli {
+
+namespace {
+
+constexpr const char* kSimulateUsage =
+    "usage: hapticjam simulate SESSION.json --out DIR [--mass KG] [--k N_PER_M]\n"
+    "                          [--kappa-jam NM_PER_RAD] [--segments P] [--solver static|explicit]\n"
+    "Replays the steps of a measurement session (docs/session-format.md; its frames\n"
+    "need not exist) and writes the predicted frame of every capture to DIR under the\n"
+    "same relative name, on the session's sample grid (CSV, mm).\n"
+    "  --mass KG            total membrane mass (default 0.55 kg per 12 cells)\n"
+    "  --k N_PER_M          spring stiffness (default 64.5)\n"
+    "  --kappa-jam NM_PER_RAD  jammed bending stiffness (default 4.79)\n"
+    "  --segments P         segments per cell edge, >= 2 (default 4)\n"
+    "  --solver NAME        static (default, Newton) or explicit (the paper's Euler)\n";
+
+struct SimulateArgs {
+  std::string session;
+  std::string out;
+  std::optional<double> mass_kg, spring_k, kappa_jam;
+  int segments = 4;
+  SolverKind solver = SolverKind::kStatic;
+};
+
+double parse_number(const std::string& flag, const std::string& text) {
+  size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(value))
+    throw std::invalid_argument(flag + " needs a finite number, got \"" + text + "\"");
+  return value;
+}
+
+SimulateArgs parse_simulate_args(const std::vector<std::string>& args, bool need_session) {
+  SimulateArgs out;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
+      return args[++i];
+    };
+    if (a == "--out") out.out = value();
+    else if (a == "--mass") out.mass_kg = parse_number(a, value());
+    else if (a == "--k") out.spring_k = parse_number(a, value());
+    else if (a == "--kappa-jam") out.kappa_jam = parse_number(a, value());
+    else if (a == "--segments") {
+      const double p = parse_number(a, value());
+      if (p != std::floor(p) || p < 2 || p > 1000) throw std::invalid_argument("--segments needs a whole number from 2 to 1000");
+      out.segments = static_cast<int>(p);
+    } else if (a == "--solver") out.solver = parse_solver_kind(value());
+    else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
+    else if (need_session && out.session.empty()) out.session = a;
+    else throw std::invalid_argument("unexpected argument \"" + a + "\"");
+  }
+  if (need_session && out.session.empty()) throw std::invalid_argument("missing SESSION.json");
+  if (out.out.empty()) throw std::invalid_argument("missing --out DIR");
+  return out;
+}
+
+int simulate(const SimulateArgs& args) {
+  const Session session = read_session(args.session);
+  SurfaceParameters params = SurfaceParameters::paper_defaults(session.device.geometry());
+  if (args.mass_kg) params.mass_kg = *args.mass_kg;
+  if (args.spring_k) params.spring_k = *args.spring_k;
+  if (args.kappa_jam) params.kappa_jam = *args.kappa_jam;
+  params.max_pressure_pa = session.device.max_pressure_kpa * 1000.0;
+  params.validate();
+  SimulatorOptions options;
+  options.solver = args.solver;
+
+  const auto start = std::chrono::steady_clock::now();
+  ProgressLine progress("simulate " + session.name);
+  int settles = 0;
+  long iterations = 0;
+  const auto captures = replay_session(session, args.segments, params, options,
+                                       [&](int done, int total, const SessionStep& step, const SettleReport& settle) {
+                                         std::string what = step.kind == SessionStep::Kind::kCapture
+                                                                ? "capture " + step.frame
+                                                                : step.action.describe();
+                                         if (step.kind == SessionStep::Kind::kAction) {
+                                           ++settles;
+                                           iterations += settle.iterations;
+                                         }
+                                         progress.update(done, total, what);
+                                       });
+  progress.finish();
+  const std::filesystem::path out_dir(args.out);
+  for (const auto& c : captures) write_frame_csv(out_dir / c.frame, c.heights_mm);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%s: %d steps, %d settles (%ld %s iterations), %zu frames written to %s in %.2f s\n",
+              session.name.c_str(), static_cast<int>(session.steps.size()), settles, iterations,
+              args.solver == SolverKind::kStatic ? "Newton" : "Euler", captures.size(), out_dir.c_str(), seconds);
+  return 0;
+}
+
+}  // namespace
+
+int run_simulate(const std::vector<std::string>& args) {
+  for (const auto& a : args)
+    if (a == "--help" || a == "-h") {
+      std::cout << kSimulateUsage;
+      return 0;
+    }
+  SimulateArgs parsed;
+  try {
+    parsed = parse_simulate_args(args, true);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "hapticjam simulate: " << e.what() << "\n" << kSimulateUsage;
+    return 2;
+  }
+  return simulate(parsed);
+}
+
+int run_demo(const std::vector<std::string>& args) {
+  std::vector<std::string> with_default = args;
+  bool has_out = false;
+  for (const auto& a : args) has_out |= a == "--out";
+  if (!has_out) with_default.insert(with_default.end(), {"--out", "hapticjam-demo"});
+  SimulateArgs parsed;
+  try {
+    parsed = parse_simulate_args(with_default, false);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "hapticjam demo: " << e.what() << "\n";
+    return 2;
+  }
+  // The output folder becomes a complete session: the steps and the frames.
+  std::filesystem::create_directories(parsed.out);
+  parsed.session = (std::filesystem::path(parsed.out) / "session.json").string();
+  std::ofstream(parsed.session) << kDemoSessionJson;
+  return simulate(parsed);
+}
+
+}  // namespace hj::cli

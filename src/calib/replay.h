@@ -1,0 +1,31 @@
+// Replays a measurement session's steps in the simulator and predicts each
+// capture: the settled surface rasterised onto the session's sample grid
+// (docs/model.md, "Measured surfaces").
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/session.h"
+#include "sim/simulator.h"
+
+namespace hj {
+
+struct PredictedCapture {
+  int step_index = 0;        // position in the session's "steps"
+  std::string frame;         // relative frame path, as in the session
+  std::string label;
+  Eigen::MatrixXd heights_mm;  // (ny x nx), NaN where no triangle covers
+};
+
+// Called after each step: steps done, steps in all, and the step's report.
+using ReplayProgress = std::function<void(int done, int total, const SessionStep& step, const SettleReport& settle)>;
+
+// The session's device with `params` (whose max pressure is replaced by the
+// session's). Throws SessionError naming the step when an action fails.
+std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,
+                                             const SimulatorOptions& options, const ReplayProgress& progress = {});
+
+}  // namespace hj

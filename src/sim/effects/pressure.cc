@@ -1,0 +1,42 @@
+// Chamber pressure on every free point: F = P A_spp n, with the flat area
+// per point A_spp = (R s)(C s) / N and the Eq. 3 normal
+//   n = normalize((x[i][j+1] - x[i][j-1]) x (x[i+1][j] - x[i-1][j])).
+// A follower load: not the gradient of an energy, so its stiffness is not
+// symmetric.
+#include "sim/effect_registry.h"
+#include "sim/normal.h"
+
+namespace hj {
+namespace {
+
+class Pressure final : public Effect {
+ public:
+  std::string_view name() const override { return "pressure"; }
+
+  void add_forces(const ForceContext& ctx, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& f) const override {
+    const double load = ctx.state.pressure_pa * ctx.mesh.area_per_point();
+    if (load == 0.0) return;
+    for_each_inner_point(ctx.mesh, [&](int p, const NormalStencil& s) {
+      f.col(p) += load * s.normal(x);
+    });
+  }
+
+  void add_stiffness(const ForceContext& ctx, const Eigen::Matrix3Xd& x, StiffnessSink& sink) const override {
+    const double load = ctx.state.pressure_pa * ctx.mesh.area_per_point();
+    if (load == 0.0) return;
+    for_each_inner_point(ctx.mesh, [&](int p, const NormalStencil& s) {
+      const NormalJacobian dn = s.normal_jacobian(x);
+      // K = -dF/dx.
+      sink.add(p, s.right, -load * dn.d_right);
+      sink.add(p, s.left, load * dn.d_right);
+      sink.add(p, s.up, -load * dn.d_up);
+      sink.add(p, s.down, load * dn.d_up);
+    });
+  }
+};
+
+HJ_REGISTER_EFFECT(EffectInfo{"pressure", "chamber pressure P A_spp along the Eq. 3 normal", true, {},
+                              [] { return std::make_unique<Pressure>(); }});
+
+}  // namespace
+}  // namespace hj

@@ -1,0 +1,14 @@
+// What a settle to static equilibrium did, for progress lines and benchmarks.
+#pragma once
+
+namespace hj {
+
+struct SettleReport {
+  bool converged = false;
+  int iterations = 0;        // Newton steps or time steps
+  int restarts = 0;          // moves off a saddle or singular state
+  double residual_n = 0.0;   // largest |F| on a free point at the end, N
+  double seconds = 0.0;      // wall time
+};
+
+}  // namespace hj

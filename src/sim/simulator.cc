@@ -1,0 +1,84 @@
+#include "sim/simulator.h"
+
+#include <stdexcept>
+
+#include "sim/effect_registry.h"
+#include "sim/jamming_springs.h"
+
+namespace hj {
+
+namespace {
+
+std::vector<std::unique_ptr<Effect>> build_effects(const std::vector<std::string>& extra) {
+  auto effects = make_baseline_effects();
+  for (const auto& name : extra) effects.push_back(EffectRegistry::instance().get(name).make());
+  return effects;
+}
+
+}  // namespace
+
+SolverKind parse_solver_kind(const std::string& name) {
+  if (name == "static") return SolverKind::kStatic;
+  if (name == "explicit") return SolverKind::kExplicit;
+  throw std::invalid_argument("unknown solver \"" + name + "\": use static or explicit");
+}
+
+Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& params, SimulatorOptions options)
+    : options_(std::move(options)), model_(Mesh(geometry), params, build_effects(options_.extra_effects)) {
+  options_.static_options.validate();
+  options_.explicit_options.validate();
+  state_ = DeviceState::flat(model_.mesh());
+  settle();
+}
+
+void Simulator::settle() {
+  if (options_.solver == SolverKind::kExplicit) {
+    last_ = settle_explicit(model_, state_, options_.explicit_options);
+    return;
+  }
+  const Eigen::Matrix3Xd before = state_.x;
+  last_ = settle_static(model_, state_, options_.static_options);
+  if (last_.converged) return;
+  // Safe fallback: relax dynamically from the previous state, then polish.
+  state_.x = before;
+  const SettleReport dynamic = settle_explicit(model_, state_, options_.explicit_options);
+  last_ = settle_static(model_, state_, options_.static_options);
+  last_.iterations += dynamic.iterations;
+  last_.seconds += dynamic.seconds;
+}
+
+const SettleReport& Simulator::apply(const Action& action) {
+  action.validate(mesh(), params());
+  const DeviceState before = state_;
+  const Mesh& m = mesh();
+  switch (action.op) {
+    case Action::Op::kSetPressure:
+      state_.pressure_pa = action.pressure_pa;
+      break;
+    case Action::Op::kJam:
+      if (state_.jammed(m, action.a, action.b)) return last_ = SettleReport{true}, last_;
+      state_.cell_jammed[m.cell_index(action.a, action.b)] = 1;
+      // The cell keeps the bend it has now: phi_eq = phi.
+      for (int p : m.cell_interior(action.a, action.b))
+        for (const BendSpring& s : bend_springs_at(m, p)) state_.phi_eq(s.axis, p) = bend_angle_of(state_.x, s);
+      break;
+    case Action::Op::kUnjam:
+      state_.cell_jammed[m.cell_index(action.a, action.b)] = 0;
+      break;
+    case Action::Op::kPin:
+      state_.node_pinned[m.node_index(action.a, action.b)] = 1;
+      break;
+    case Action::Op::kUnpin:
+      state_.node_pinned[m.node_index(action.a, action.b)] = 0;
+      break;
+  }
+  settle();
+  if (!last_.converged) {
+    state_ = before;
+    throw std::runtime_error("no static equilibrium found after " + action.describe() + " (residual " +
+                             std::to_string(last_.residual_n) + " N)");
+  }
+  return last_;
+}
+
+}  // namespace hj

@@ -1,0 +1,56 @@
+// The simulated device: a force model, a state, and the five actions, each
+// followed by a settle to static equilibrium from the state before it
+// (docs/model.md, "States and actions").
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "model/action.h"
+#include "sim/explicit_euler.h"
+#include "sim/force_model.h"
+#include "sim/static_solver.h"
+
+namespace hj {
+
+enum class SolverKind { kStatic, kExplicit };
+
+struct SimulatorOptions {
+  SolverKind solver = SolverKind::kStatic;
+  StaticSolverOptions static_options;
+  ExplicitEulerOptions explicit_options;
+  // Effects beyond the baseline, by registry name.
+  std::vector<std::string> extra_effects;
+};
+
+class Simulator {
+ public:
+  // Builds the mesh and settles the rest state (P = 0, a sag). Throws
+  // std::invalid_argument on a bad geometry, parameter or option.
+  Simulator(const ArrayGeometry& geometry, const SurfaceParameters& params, SimulatorOptions options = {});
+
+  const Mesh& mesh() const { return model_.mesh(); }
+  const SurfaceParameters& params() const { return model_.params(); }
+  const ForceModel& model() const { return model_; }
+  const DeviceState& state() const { return state_; }
+  const SettleReport& last_settle() const { return last_; }
+
+  // Validates (std::invalid_argument naming what is wrong), applies and
+  // settles. Repeating an action changes nothing. Throws std::runtime_error
+  // if no equilibrium is found (the state is left as it was).
+  const SettleReport& apply(const Action& action);
+
+ private:
+  void settle();
+
+  SimulatorOptions options_;
+  ForceModel model_;
+  DeviceState state_;
+  SettleReport last_;
+};
+
+// Parses "static" / "explicit"; std::invalid_argument otherwise.
+SolverKind parse_solver_kind(const std::string& name);
+
+}  // namespace hj

@@ -1,0 +1,34 @@
+// Static equilibrium by pseudo-transient continuation: Newton steps on the
+// force residual, each regularised as an implicit step of the overdamped
+// flow c dx/dt = F(x),
+//   (K + mu I) dx = F,   K = -dF/dx (analytic, sparse), mu = c / dt,
+// with mu shrinking as the residual falls (switched evolution relaxation),
+// so it starts as a heavily damped relaxation from the previous state and
+// ends as Newton. A converged state whose symmetric stiffness is not
+// positive definite (a saddle, or the creased net near levelling) is pushed
+// along its unstable mode and settled again.
+#pragma once
+
+#include "model/device_state.h"
+#include "sim/force_model.h"
+#include "sim/settle_report.h"
+
+namespace hj {
+
+struct StaticSolverOptions {
+  double force_tolerance_n = 1e-9;   // largest |F| on a free point at the end
+  int max_iterations = 400;
+  double initial_shift = 0.1;        // mu at the start, in units of spring_k
+  double max_step_fraction = 1.0;    // largest move of a point per step, in h
+  int max_restarts = 6;              // pushes off unstable equilibria
+  bool check_stability = true;
+
+  // Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+// Settles state.x in place from where it is. Never throws on a hard case:
+// returns converged = false, leaving the best state found.
+SettleReport settle_static(const ForceModel& model, DeviceState& state, const StaticSolverOptions& options = {});
+
+}  // namespace hj
