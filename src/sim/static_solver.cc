@@ -137,7 +137,8 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
     // it holds, and stay put while it does not.
     const Eigen::VectorXd predicted = (1.0 - scale) * residual + (scale * mu) * full_step;
     const double rho = (residual_trial - predicted).norm() / std::max((residual - predicted).norm(), 1e-300);
-    if (rho > 1.0 && !(residual_trial.norm() < residual.norm())) {
+    const double old_norm = residual.norm(), new_norm = residual_trial.norm();
+    if (rho > 1.0 && !(new_norm < old_norm)) {
       mu = std::max(4.0 * mu, mu0);
       continue;
     }
@@ -148,10 +149,8 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
       mu *= 0.1;
     else if (rho < 0.3)
       mu *= 0.3;
-    else if (rho < 1.0)
+    else if (rho < 1.0 || new_norm < 0.9 * old_norm)
       mu *= 0.7;
-    else
-      mu *= 2.0;
     if (mu < 1e-10 * mu0) mu = 0.0;
   }
   report.residual_n = max_free_force(f, fixed);

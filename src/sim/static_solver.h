@@ -17,7 +17,7 @@ namespace hj {
 
 struct StaticSolverOptions {
   double force_tolerance_n = 1e-9;   // largest |F| on a free point at the end
-  int max_iterations = 400;
+  int max_iterations = 1000;
   double initial_shift = 0.1;        // mu at the start, in units of spring_k
   double max_step_fraction = 1.0;    // largest move of a point per step, in h
   int max_restarts = 6;              // pushes off unstable equilibria

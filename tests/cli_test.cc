@@ -1,0 +1,138 @@
+// The hapticjam command line (clients/cli): `simulate` replays a session and
+// writes one frame per capture on the session's grid; a malformed session
+// or option exits non-zero with a message naming what is wrong.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "calib/frame_csv.h"
+
+namespace hj {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kPaperSequence = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline/paper-sequence";
+
+// A fresh folder for this test, removed at the end.
+struct ScratchDir {
+  ScratchDir() {
+    const auto* test = testing::UnitTest::GetInstance()->current_test_info();
+    path = fs::path(testing::TempDir()) /
+           ("hj_cli_" + std::to_string(::getpid()) + "_" + test->test_suite_name() + "." + test->name());
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+  fs::path path;
+};
+
+std::string quoted(const fs::path& p) {
+  std::string out(1, '\'');
+  out += p.string();
+  out += '\'';
+  return out;
+}
+
+// Runs the CLI with `args`, stdout and stderr to files in `dir`; returns
+// the exit code (-1 if it did not exit normally).
+int run_cli(const std::string& args, const fs::path& dir) {
+  const std::string command = quoted(HJ_CLI_PATH) + " " + args + " >" + quoted(dir / "stdout.txt") + " 2>" +
+                              quoted(dir / "stderr.txt");
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+const std::string kTrueParameters = " --mass 0.52 --k 58 --kappa-jam 4.2";
+
+TEST(Cli, SimulateWritesEveryCaptureFrame) {
+  ScratchDir dir;
+  const fs::path out = dir.path / "out";
+  ASSERT_EQ(run_cli("simulate " + quoted(kPaperSequence / "session.json") + kTrueParameters + " --out " + quoted(out),
+                    dir.path),
+            0)
+      << read_text(dir.path / "stderr.txt");
+  for (const char* frame : {"frames/000.csv", "frames/001.csv", "frames/002.csv", "frames/003.csv"}) {
+    SCOPED_TRACE(frame);
+    ASSERT_TRUE(fs::exists(out / frame));
+    // 58 lines of 77 finite numbers (mm).
+    std::ifstream in(out / frame);
+    std::string line;
+    int lines = 0;
+    while (std::getline(in, line)) {
+      ++lines;
+      std::stringstream fields(line);
+      std::string field;
+      int n = 0;
+      while (std::getline(fields, field, ',')) {
+        size_t used = 0;
+        const double v = std::stod(field, &used);
+        EXPECT_EQ(used, field.size()) << "line " << lines << " field " << n << ": \"" << field << "\"";
+        EXPECT_TRUE(std::isfinite(v)) << "line " << lines << " field " << n;
+        ++n;
+      }
+      EXPECT_EQ(n, 77) << "line " << lines;
+    }
+    EXPECT_EQ(lines, 58);
+    // And the prediction matches the dataset's capture to the noise floor.
+    const Eigen::MatrixXd predicted = read_frame_csv(out / frame, 58, 77);
+    const Eigen::MatrixXd real = read_frame_csv(kPaperSequence / frame, 58, 77);
+    double sum = 0.0;
+    int count = 0;
+    for (int i = 0; i < real.size(); ++i)
+      if (!std::isnan(real(i)) && !std::isnan(predicted(i))) sum += std::abs(real(i) - predicted(i)), ++count;
+    EXPECT_LE(sum / count, 1.2);
+  }
+}
+
+TEST(Cli, MalformedSessionNamesTheStepAndKey) {
+  ScratchDir dir;
+  nlohmann::json session = nlohmann::json::parse(read_text(kPaperSequence / "session.json"));
+  int bad_step = -1;
+  for (size_t i = 0; i < session["steps"].size() && bad_step < 0; ++i)
+    if (session["steps"][i]["op"] == "jam") {
+      session["steps"][i]["cell"] = {7, 0};
+      bad_step = static_cast<int>(i);
+    }
+  ASSERT_GE(bad_step, 0);
+  std::ofstream(dir.path / "session.json") << session.dump(1);
+
+  const int code = run_cli("simulate " + quoted(dir.path / "session.json") + " --out " + quoted(dir.path / "out"),
+                           dir.path);
+  EXPECT_NE(code, 0);
+  const std::string err = read_text(dir.path / "stderr.txt");
+  EXPECT_NE(err.find("steps[" + std::to_string(bad_step) + "]"), std::string::npos) << err;
+  EXPECT_NE(err.find("cell"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir.path / "out" / "frames" / "000.csv")) << "no frames from a refused session";
+}
+
+TEST(Cli, TooFewSegmentsIsAUsageError) {
+  ScratchDir dir;
+  const int code = run_cli("simulate " + quoted(kPaperSequence / "session.json") + " --segments 1 --out " +
+                               quoted(dir.path / "out"),
+                           dir.path);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(read_text(dir.path / "stderr.txt").find("--segments"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hj
