@@ -1,0 +1,53 @@
+// Settling speed: from rest to 2 kPa, and one action after that (jam a cell,
+// then 1 kPa), for the static solver and the paper's explicit Euler.
+// Run: ./build/hj_bench --benchmark_filter=Settle
+#include <benchmark/benchmark.h>
+
+#include "sim/simulator.h"
+
+namespace {
+
+using hj::Action;
+using hj::ArrayGeometry;
+using hj::SimulatorOptions;
+using hj::SolverKind;
+
+// args: rows, cols, segments, solver (0 static, 1 explicit)
+void BM_SettleRestTo2kPa(benchmark::State& state) {
+  const ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038,
+                        static_cast<int>(state.range(2))};
+  SimulatorOptions options;
+  options.solver = state.range(3) == 0 ? SolverKind::kStatic : SolverKind::kExplicit;
+  long iterations = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
+    state.ResumeTiming();
+    iterations += sim.apply(Action::set_pressure(2000.0)).iterations;
+  }
+  state.counters["solver_iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+}
+
+void BM_SettleOneActionAfter2kPa(benchmark::State& state) {
+  const ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038,
+                        static_cast<int>(state.range(2))};
+  SimulatorOptions options;
+  options.solver = state.range(3) == 0 ? SolverKind::kStatic : SolverKind::kExplicit;
+  long iterations = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
+    sim.apply(Action::set_pressure(2000.0));
+    sim.apply(Action::jam(1, 1));
+    state.ResumeTiming();
+    iterations += sim.apply(Action::set_pressure(1000.0)).iterations;
+  }
+  state.counters["solver_iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+}
+
+BENCHMARK(BM_SettleRestTo2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_SettleOneActionAfter2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
+// The slow ones, run by name: 9 x 12 explicit, and p = 10.
+BENCHMARK(BM_SettleRestTo2kPa)->Name("Slow/BM_SettleRestTo2kPa")->Args({9, 12, 4, 1})->Args({9, 12, 10, 0})->Unit(benchmark::kMillisecond)->Iterations(1);
+
+}  // namespace
