@@ -3,6 +3,8 @@
 // with the right shapes, malformed input names its key, rasterised planes
 // come out exact.
 #include <gtest/gtest.h>
+
+#include "scratch_dir.h"
 #include <unistd.h>
 
 #include <cmath>
@@ -26,22 +28,7 @@ using nlohmann::json;
 const fs::path kBaseline = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// A fresh empty folder, unique to this process and test (tests may run in
-// parallel), removed when it goes out of scope.
-struct ScratchDir {
-  explicit ScratchDir(const std::string& label) {
-    const testing::TestInfo* test = testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::path(testing::TempDir()) / ("hj_calib_io_" + std::to_string(::getpid()) + "_" +
-                                           test->test_suite_name() + "." + test->name() + "." + label);
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-  fs::path path;
-};
+using testing_support::ScratchDir;
 
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

@@ -2,6 +2,8 @@
 // writes one frame per capture on the session's grid; a malformed session
 // or option exits non-zero with a message naming what is wrong.
 #include <gtest/gtest.h>
+
+#include "scratch_dir.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,21 +25,7 @@ namespace fs = std::filesystem;
 
 const fs::path kPaperSequence = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline/paper-sequence";
 
-// A fresh folder for this test, removed at the end.
-struct ScratchDir {
-  ScratchDir() {
-    const auto* test = testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::path(testing::TempDir()) /
-           ("hj_cli_" + std::to_string(::getpid()) + "_" + test->test_suite_name() + "." + test->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-  fs::path path;
-};
+using testing_support::ScratchDir;
 
 std::string quoted(const fs::path& p) {
   std::string out(1, '\'');
