@@ -19,6 +19,7 @@ void StaticSolverOptions::validate() const {
   };
   if (!(force_tolerance_n > 0.0) || !std::isfinite(force_tolerance_n)) bad("force_tolerance_n", "(N) must be > 0");
   if (max_iterations < 1) bad("max_iterations", "must be at least 1");
+  if (fast_iterations < 0) bad("fast_iterations", "must be >= 0");
   if (!(initial_shift >= 0.0) || !std::isfinite(initial_shift)) bad("initial_shift", "(x spring_k) must be >= 0");
   if (!(max_step_fraction > 0.0)) bad("max_step_fraction", "(x h) must be > 0");
   if (max_restarts < 0) bad("max_restarts", "must be >= 0");
@@ -64,43 +65,44 @@ Eigen::VectorXd unstable_mode(const StiffnessMatrix& k) {
   return v;
 }
 
-}  // namespace
+// How the shift mu follows the iterations.
+enum class StepControl {
+  // mu shrinks 3x per step while steps stay under the cap, grows to keep
+  // them there: an implicit overdamped flow at a fixed displacement per step
+  // ending as Newton. Fast where the linear model holds over a step.
+  kDisplacement,
+  // mu shrinks only while the linear model predicts the new residual well
+  // (rho below), and grows when it fails: slower, but it holds on stiff
+  // jammed cells whose rotation the linear model gets wrong.
+  kModelTrust,
+};
 
-SettleReport settle_static(const ForceModel& model, DeviceState& state, const StaticSolverOptions& options) {
-  options.validate();
-  const auto start = Clock::now();
+using Lu = Eigen::UmfPackLU<Eigen::SparseMatrix<double>>;
+
+// Iterates from state.x; returns with report.converged set when a stable
+// equilibrium (or max_restarts pushes) is reached within max_iterations.
+void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatrix& k, Lu& lu,
+                      const std::vector<char>& fixed, const StaticSolverOptions& options, StepControl control,
+                      int max_iterations, double mu0, SettleReport& report) {
   const Mesh& mesh = model.mesh();
-  const std::vector<char> fixed = state.fixed_points(mesh);
-  StiffnessMatrix k(mesh, fixed, [&](StiffnessSink& sink) { model.add_stiffness(state, state.x, sink); });
-  SettleReport report;
-  if (k.num_dofs() == 0) {
-    report.converged = true;
-    return report;
-  }
-  // UMFPACK (SuiteSparse): about 1.5x faster than Eigen's SparseLU here.
-  Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu;
-  lu.analyzePattern(k.matrix());
-
-  const double mu0 = options.initial_shift * model.params().spring_k;
   const double max_step = options.max_step_fraction * mesh.spacing();
   Eigen::Matrix3Xd f, f_trial;
   model.forces(state, state.x, f);
   Eigen::VectorXd residual = k.gather(f);
   double mu = mu0;
-
-  for (report.iterations = 0; report.iterations < options.max_iterations; ++report.iterations) {
+  for (int it = 0; it < max_iterations; ++it, ++report.iterations) {
     report.residual_n = max_free_force(f, fixed);
     if (report.residual_n < options.force_tolerance_n) {
       if (!options.check_stability || report.restarts >= options.max_restarts) {
         report.converged = true;
-        break;
+        return;
       }
       k.set_zero();
       model.add_stiffness(state, state.x, k);
       const Eigen::VectorXd mode = unstable_mode(k);
       if (mode.size() == 0) {
         report.converged = true;
-        break;
+        return;
       }
       // Push off the saddle by a small fraction of h and relax again.
       Eigen::Matrix3Xd push = k.scatter(mode);
@@ -118,12 +120,10 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
     model.add_stiffness(state, state.x, k);
     add_shift(k, mu);
     lu.factorize(k.matrix());
-    if (lu.info() != Eigen::Success) {
-      mu = std::max(4.0 * mu, mu0);
-      continue;
-    }
-    const Eigen::VectorXd full_step = lu.solve(residual);
-    const double largest = full_step.reshaped(3, full_step.size() / 3).colwise().norm().maxCoeff();
+    const Eigen::VectorXd full_step =
+        lu.info() == Eigen::Success ? Eigen::VectorXd(lu.solve(residual)) : Eigen::VectorXd();
+    const double largest =
+        full_step.size() ? full_step.reshaped(3, full_step.size() / 3).colwise().norm().maxCoeff() : NAN;
     if (!std::isfinite(largest)) {
       mu = std::max(4.0 * mu, mu0);
       continue;
@@ -132,28 +132,68 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
     const Eigen::Matrix3Xd x_trial = state.x + k.scatter(scale * full_step);
     model.forces(state, x_trial, f_trial);
     const Eigen::VectorXd residual_trial = k.gather(f_trial);
-    // The linear model predicts F - K s dx = (1 - s) F + s mu dx; rho is
-    // the error of the predicted change. Trust it more (smaller mu) while
-    // it holds, and stay put while it does not.
-    const Eigen::VectorXd predicted = (1.0 - scale) * residual + (scale * mu) * full_step;
-    const double rho = (residual_trial - predicted).norm() / std::max((residual - predicted).norm(), 1e-300);
     const double old_norm = residual.norm(), new_norm = residual_trial.norm();
-    if (rho > 1.0 && !(new_norm < old_norm)) {
-      mu = std::max(4.0 * mu, mu0);
-      continue;
+    if (control == StepControl::kDisplacement) {
+      if (!(new_norm < 10.0 * old_norm)) {
+        mu = std::max(4.0 * mu, mu0);
+        continue;
+      }
+      mu = scale < 1.0 ? std::max(mu, 1e-6 * mu0) * std::min(10.0, 1.0 / scale) : 0.3 * mu;
+    } else {
+      // The linear model predicts F - K s dx = (1 - s) F + s mu dx; rho is
+      // the error of the predicted change.
+      const Eigen::VectorXd predicted = (1.0 - scale) * residual + (scale * mu) * full_step;
+      const double rho = (residual_trial - predicted).norm() / std::max((residual - predicted).norm(), 1e-300);
+      if (rho > 1.0 && !(new_norm < old_norm)) {
+        mu = std::max(4.0 * mu, mu0);
+        continue;
+      }
+      if (rho < 0.1)
+        mu *= 0.1;
+      else if (rho < 0.3)
+        mu *= 0.3;
+      else if (rho < 1.0 || new_norm < 0.9 * old_norm)
+        mu *= 0.7;
     }
     state.x = x_trial;
     f.swap(f_trial);
     residual = residual_trial;
-    if (rho < 0.1)
-      mu *= 0.1;
-    else if (rho < 0.3)
-      mu *= 0.3;
-    else if (rho < 1.0 || new_norm < 0.9 * old_norm)
-      mu *= 0.7;
     if (mu < 1e-10 * mu0) mu = 0.0;
   }
   report.residual_n = max_free_force(f, fixed);
+}
+
+}  // namespace
+
+SettleReport settle_static(const ForceModel& model, DeviceState& state, const StaticSolverOptions& options) {
+  options.validate();
+  const auto start = Clock::now();
+  const Mesh& mesh = model.mesh();
+  const std::vector<char> fixed = state.fixed_points(mesh);
+  StiffnessMatrix k(mesh, fixed, [&](StiffnessSink& sink) { model.add_stiffness(state, state.x, sink); });
+  SettleReport report;
+  if (k.num_dofs() == 0) {
+    report.converged = true;
+    return report;
+  }
+  // UMFPACK (SuiteSparse): about 1.5x faster than Eigen's SparseLU here.
+  Lu lu;
+  lu.analyzePattern(k.matrix());
+  const double mu0 = options.initial_shift * model.params().spring_k;
+  // The fast control first, within a small budget; where it does not
+  // settle, the careful one from the same start.
+  const Eigen::Matrix3Xd start_x = state.x;
+  if (options.fast_iterations > 0) {
+    run_continuation(model, state, k, lu, fixed, options, StepControl::kDisplacement, options.fast_iterations, mu0,
+                     report);
+    if (!report.converged) {
+      state.x = start_x;
+      report.restarts = 0;
+    }
+  }
+  if (!report.converged)
+    run_continuation(model, state, k, lu, fixed, options, StepControl::kModelTrust, options.max_iterations, mu0,
+                     report);
   report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return report;
 }

@@ -17,7 +17,8 @@ namespace hj {
 
 struct StaticSolverOptions {
   double force_tolerance_n = 1e-9;   // largest |F| on a free point at the end
-  int max_iterations = 1000;
+  int max_iterations = 1000;         // for the careful step control
+  int fast_iterations = 40;          // budget of the fast one, tried first (0: skip)
   double initial_shift = 0.1;        // mu at the start, in units of spring_k
   double max_step_fraction = 1.0;    // largest move of a point per step, in h
   int max_restarts = 6;              // pushes off unstable equilibria
