@@ -6,10 +6,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
 #include "sim/stiffness_matrix.h"
+
+// OpenBLAS, when it is the system BLAS under UMFPACK, would spin threads
+// on sparse fronts far too small to share; set to one thread if present.
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
 namespace hj {
 
@@ -176,8 +181,14 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
     report.converged = true;
     return report;
   }
+  static std::once_flag blas_threads;
+  std::call_once(blas_threads, [] {
+    if (openblas_set_num_threads) openblas_set_num_threads(1);
+  });
   // UMFPACK (SuiteSparse): about 1.5x faster than Eigen's SparseLU here.
   Lu lu;
+  // No iterative refinement: the Newton iteration itself corrects the step.
+  lu.umfpackControl()(UMFPACK_IRSTEP) = 0;
   lu.analyzePattern(k.matrix());
   const double mu0 = options.initial_shift * model.params().spring_k;
   // The fast control first, within a small budget; where it does not
