@@ -124,3 +124,32 @@ TEST(Cli, TooFewSegmentsIsAUsageError) {
 
 }  // namespace
 }  // namespace hj
+
+namespace hj {
+namespace {
+
+TEST(Cli, PlanWritesAReplayablePlanForARealDem) {
+  ScratchDir dir;
+  const fs::path out = dir.path / "plan";
+  const fs::path dem = fs::path(HJ_SHARED_DIR) / "data/dem/volcano_maunga_whau.csv";
+  ASSERT_EQ(run_cli("plan " + quoted(dem) + " --rows 3 --cols 4 --out " + quoted(out), dir.path), 0)
+      << read_text(dir.path / "stderr.txt");
+  const auto plan = nlohmann::json::parse(read_text(out / "plan.json"));
+  ASSERT_TRUE(plan["correlation"].is_number());
+  EXPECT_GT(plan["correlation"].get<double>(), 0.5);
+  EXPECT_GT(plan["laplace_mean"].get<double>(), 0.0);
+  ASSERT_FALSE(plan["steps"].empty());
+  for (const auto& step : plan["steps"]) EXPECT_TRUE(step.contains("op"));
+  EXPECT_TRUE(fs::exists(out / "compare.png"));
+  EXPECT_EQ(read_frame_csv(out / "predicted.csv", 13, 17).rows(), 13);
+}
+
+TEST(Cli, PlanRejectsACorruptGoalWithItsName) {
+  ScratchDir dir;
+  std::ofstream(dir.path / "broken.png") << "not a png";
+  EXPECT_NE(run_cli("plan " + quoted(dir.path / "broken.png") + " --rows 3 --cols 4 --out " + quoted(dir.path / "o"), dir.path), 0);
+  EXPECT_NE(read_text(dir.path / "stderr.txt").find("broken.png"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hj

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "plan_command.h"
 #include "simulate_command.h"
 
 namespace {
@@ -13,6 +14,7 @@ constexpr const char* kUsage =
     "commands:\n"
     "  simulate SESSION.json --out DIR   replay a session's steps, write predicted frames\n"
     "  demo [--out DIR]                  simulate the paper's Fig. 7 sequence (embedded)\n"
+    "  plan GOAL --rows R --cols C --out DIR   plan a goal shape (Algorithm 2)\n"
     "run 'hapticjam COMMAND --help' for a command's options\n";
 
 }  // namespace
@@ -23,6 +25,7 @@ int main(int argc, char** argv) {
   try {
     if (command == "simulate") return hj::cli::run_simulate(args);
     if (command == "demo") return hj::cli::run_demo(args);
+    if (command == "plan") return hj::cli::run_plan(args);
     if (command == "--help" || command == "-h" || command == "help") {
       std::cout << kUsage;
       return 0;

@@ -1,0 +1,177 @@
+#include "plan_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "calib/frame_csv.h"
+#include "calib/step_json.h"
+#include "compare_image.h"
+#include "metrics/correlation.h"
+#include "metrics/laplace_predictor.h"
+#include "plan/planner.h"
+#include "progress.h"
+#include "shapes/goal_importer.h"
+#include "shapes/region.h"
+#include "shapes/resample.h"
+#include "sim/surface_measures.h"
+
+namespace hj::cli {
+
+namespace {
+
+constexpr const char* kPlanUsage =
+    "usage: hapticjam plan GOAL --rows R --cols C --out DIR [--segments P] [--planner NAME]\n"
+    "                      [--max-height-mm H] [--region x0,y0,x1,y1] [--hue] [--json]\n"
+    "Plans the actions that make the display show GOAL (a height image: CSV, PNG,\n"
+    "TIFF) and writes DIR/plan.json (steps in the session format, correlation,\n"
+    "Laplace mean), DIR/predicted.csv and DIR/goal.csv (mm per mesh point, row i\n"
+    "along +y) and DIR/compare.png.\n"
+    "  --rows R, --cols C    array size in cells (38 mm cells)\n"
+    "  --segments P          segments per cell edge (default 4)\n"
+    "  --planner NAME        default algorithm2\n"
+    "  --max-height-mm H     goal height range on the display (default 30 mm)\n"
+    "  --region x0,y0,x1,y1  zoom: pixels, or fractions of the image if all <= 1\n"
+    "  --hue                 colour topographic map: red-orange high, blue-purple low\n"
+    "  --json                print the summary as JSON\n";
+
+struct PlanArgs {
+  std::string goal, out, planner = "algorithm2", region;
+  int rows = 0, cols = 0, segments = 4;
+  double max_height_mm = kDefaultMaxHeightMm;
+  bool hue = false, json = false;
+};
+
+int parse_int(const std::string& flag, const std::string& text, int lo, int hi) {
+  size_t used = 0;
+  long v = 0;
+  try {
+    v = std::stol(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || v < lo || v > hi)
+    throw std::invalid_argument(flag + " needs a whole number from " + std::to_string(lo) + " to " +
+                                std::to_string(hi) + ", got \"" + text + "\"");
+  return static_cast<int>(v);
+}
+
+PlanArgs parse_plan_args(const std::vector<std::string>& args) {
+  PlanArgs out;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
+      return args[++i];
+    };
+    if (a == "--out") out.out = value();
+    else if (a == "--rows") out.rows = parse_int(a, value(), 1, 1000);
+    else if (a == "--cols") out.cols = parse_int(a, value(), 1, 1000);
+    else if (a == "--segments") out.segments = parse_int(a, value(), 2, 1000);
+    else if (a == "--planner") out.planner = value();
+    else if (a == "--region") out.region = value();
+    else if (a == "--hue") out.hue = true;
+    else if (a == "--json") out.json = true;
+    else if (a == "--max-height-mm") {
+      const std::string& v = value();
+      size_t used = 0;
+      try {
+        out.max_height_mm = std::stod(v, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != v.size() || !(out.max_height_mm > 0.0) || !std::isfinite(out.max_height_mm))
+        throw std::invalid_argument("--max-height-mm needs a positive number, got \"" + v + "\"");
+    } else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
+    else if (out.goal.empty()) out.goal = a;
+    else throw std::invalid_argument("unexpected argument \"" + a + "\"");
+  }
+  if (out.goal.empty()) throw std::invalid_argument("missing GOAL");
+  if (out.rows == 0 || out.cols == 0) throw std::invalid_argument("--rows and --cols are required");
+  if (out.out.empty()) throw std::invalid_argument("missing --out DIR");
+  return out;
+}
+
+// Mesh point heights (row i along +y) as an image (row 0 at the top).
+Eigen::MatrixXd as_image(const Eigen::MatrixXd& points) { return points.colwise().reverse(); }
+
+int plan(const PlanArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  HeightMap goal = import_goal(args.goal, ImportOptions{args.hue});
+  if (!args.region.empty()) goal = crop(goal, parse_region(args.region));
+  const ArrayGeometry geometry{args.rows, args.cols, 0.038, args.segments};
+  const Mesh mesh(geometry);
+  PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),
+                      resample_to_mesh(goal, mesh, args.max_height_mm), {}};
+  const auto planner = make_planner(args.planner);
+
+  ProgressLine progress("plan " + std::filesystem::path(args.goal).filename().string());
+  PlanCallbacks callbacks;
+  callbacks.progress = [&](double fraction, const std::string& what) {
+    progress.update(static_cast<int>(std::lround(fraction * 100)), 100, what);
+  };
+  const PlanResult result = planner->plan(request, callbacks);
+  progress.finish();
+
+  const Eigen::MatrixXd predicted_mm = point_heights(mesh, result.final_state.x) * 1000.0;
+  const Correlation corr = correlate_with_goal(goal.z, as_image(predicted_mm));
+  const double laplace = laplace_mean(goal.z);
+
+  const std::filesystem::path out(args.out);
+  std::filesystem::create_directories(out);
+  write_frame_csv(out / "predicted.csv", predicted_mm);
+  write_frame_csv(out / "goal.csv", request.goal_mm);
+  write_compare_png(out / "compare.png", mesh, request.goal_mm, predicted_mm);
+  nlohmann::json steps = nlohmann::json::array();
+  for (const Action& a : result.steps) steps.push_back(action_to_step_json(a));
+  const SurfaceParameters& p = request.params;
+  nlohmann::json doc = {
+      {"format", "hapticjam.plan/1"},
+      {"goal", args.goal},
+      {"array", {{"rows", args.rows}, {"cols", args.cols}, {"cell_size_mm", 38.0}, {"segments", args.segments}}},
+      {"parameters",
+       {{"mass_kg", p.mass_kg}, {"spring_k", p.spring_k}, {"kappa_jam", p.kappa_jam}, {"max_pressure_kpa", p.max_pressure_pa / 1000.0}}},
+      {"planner", planner->name()},
+      {"max_height_mm", args.max_height_mm},
+      {"steps", steps},
+      {"correlation", corr.value ? nlohmann::json(*corr.value) : nlohmann::json(nullptr)},
+      {"laplace_mean", laplace}};
+  if (!corr.value) doc["correlation_undefined"] = corr.undefined_reason;
+  std::ofstream(out / "plan.json") << doc.dump(1) << "\n";
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (args.json) {
+    nlohmann::json summary = {{"goal", args.goal}, {"rows", args.rows}, {"cols", args.cols},
+                              {"steps", result.steps.size()}, {"correlation", doc["correlation"]},
+                              {"laplace_mean", laplace}, {"seconds", seconds}, {"out", args.out}};
+    std::cout << summary.dump() << "\n";
+  } else {
+    std::printf("%s on %d x %d: %zu steps, correlation %s, Laplace mean %.3f, written to %s in %.2f s\n",
+                args.goal.c_str(), args.rows, args.cols, result.steps.size(),
+                corr.value ? std::to_string(*corr.value).substr(0, 6).c_str() : ("undefined (" + corr.undefined_reason + ")").c_str(),
+                laplace, args.out.c_str(), seconds);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_plan(const std::vector<std::string>& args) {
+  for (const auto& a : args)
+    if (a == "--help" || a == "-h") {
+      std::cout << kPlanUsage;
+      return 0;
+    }
+  PlanArgs parsed;
+  try {
+    parsed = parse_plan_args(args);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "hapticjam plan: " << e.what() << "\n" << kPlanUsage;
+    return 2;
+  }
+  return plan(parsed);
+}
+
+}  // namespace hj::cli

@@ -1,0 +1,51 @@
+#include "plan/planner.h"
+
+#include <algorithm>
+#include <map>
+#include <sstream>
+
+namespace hj {
+
+namespace {
+
+std::map<std::string, std::function<std::unique_ptr<Planner>()>>& registry() {
+  static std::map<std::string, std::function<std::unique_ptr<Planner>()>> planners;
+  return planners;
+}
+
+}  // namespace
+
+void register_planner(const std::string& name, std::function<std::unique_ptr<Planner>()> make) {
+  if (!registry().emplace(name, std::move(make)).second)
+    throw std::invalid_argument("planner \"" + name + "\" is registered twice");
+}
+
+std::vector<std::string> planner_names() {
+  std::vector<std::string> names;
+  for (const auto& [name, make] : registry()) names.push_back(name);
+  return names;
+}
+
+std::unique_ptr<Planner> make_planner(const std::string& name) {
+  const auto it = registry().find(name);
+  if (it == registry().end()) {
+    std::string known;
+    for (const auto& n : planner_names()) known += (known.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown planner \"" + name + "\"; known planners: " + known);
+  }
+  return it->second();
+}
+
+void validate_plan_request(const PlanRequest& request, const Mesh& mesh) {
+  const auto& g = request.goal_mm;
+  if (g.rows() != mesh.point_rows() || g.cols() != mesh.point_cols()) {
+    std::ostringstream err;
+    err << "goal has " << g.rows() << " x " << g.cols() << " heights; the mesh of a " << mesh.rows() << " x "
+        << mesh.cols() << " array at p = " << mesh.segments() << " has " << mesh.point_rows() << " x "
+        << mesh.point_cols() << " points";
+    throw std::invalid_argument(err.str());
+  }
+  if (!g.allFinite()) throw std::invalid_argument("goal heights must all be finite numbers (mm)");
+}
+
+}  // namespace hj
