@@ -7,6 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "args.h"
 #include "calib/frame_csv.h"
 #include "calib/step_json.h"
 #include "compare_image.h"
@@ -45,20 +46,6 @@ struct PlanArgs {
   bool hue = false, json = false;
 };
 
-int parse_int(const std::string& flag, const std::string& text, int lo, int hi) {
-  size_t used = 0;
-  long v = 0;
-  try {
-    v = std::stol(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || v < lo || v > hi)
-    throw std::invalid_argument(flag + " needs a whole number from " + std::to_string(lo) + " to " +
-                                std::to_string(hi) + ", got \"" + text + "\"");
-  return static_cast<int>(v);
-}
-
 PlanArgs parse_plan_args(const std::vector<std::string>& args) {
   PlanArgs out;
   for (size_t i = 0; i < args.size(); ++i) {
@@ -76,15 +63,8 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
     else if (a == "--hue") out.hue = true;
     else if (a == "--json") out.json = true;
     else if (a == "--max-height-mm") {
-      const std::string& v = value();
-      size_t used = 0;
-      try {
-        out.max_height_mm = std::stod(v, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != v.size() || !(out.max_height_mm > 0.0) || !std::isfinite(out.max_height_mm))
-        throw std::invalid_argument("--max-height-mm needs a positive number, got \"" + v + "\"");
+      out.max_height_mm = parse_number(a, value());
+      if (!(out.max_height_mm > 0.0)) throw std::invalid_argument("--max-height-mm needs a positive number (mm)");
     } else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
     else if (out.goal.empty()) out.goal = a;
     else throw std::invalid_argument("unexpected argument \"" + a + "\"");
@@ -159,19 +139,7 @@ int plan(const PlanArgs& args) {
 }  // namespace
 
 int run_plan(const std::vector<std::string>& args) {
-  for (const auto& a : args)
-    if (a == "--help" || a == "-h") {
-      std::cout << kPlanUsage;
-      return 0;
-    }
-  PlanArgs parsed;
-  try {
-    parsed = parse_plan_args(args);
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "hapticjam plan: " << e.what() << "\n" << kPlanUsage;
-    return 2;
-  }
-  return plan(parsed);
+  return run_subcommand<PlanArgs>("plan", kPlanUsage, args, parse_plan_args, plan);
 }
 
 }  // namespace hj::cli

@@ -8,6 +8,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "args.h"
 #include "calib/frame_csv.h"
 #include "calib/replay.h"
 #include "demo_session.h"
@@ -37,19 +38,6 @@ struct SimulateArgs {
   SolverKind solver = SolverKind::kStatic;
 };
 
-double parse_number(const std::string& flag, const std::string& text) {
-  size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || !std::isfinite(value))
-    throw std::invalid_argument(flag + " needs a finite number, got \"" + text + "\"");
-  return value;
-}
-
 SimulateArgs parse_simulate_args(const std::vector<std::string>& args, bool need_session) {
   SimulateArgs out;
   for (size_t i = 0; i < args.size(); ++i) {
@@ -62,11 +50,8 @@ SimulateArgs parse_simulate_args(const std::vector<std::string>& args, bool need
     else if (a == "--mass") out.mass_kg = parse_number(a, value());
     else if (a == "--k") out.spring_k = parse_number(a, value());
     else if (a == "--kappa-jam") out.kappa_jam = parse_number(a, value());
-    else if (a == "--segments") {
-      const double p = parse_number(a, value());
-      if (p != std::floor(p) || p < 2 || p > 1000) throw std::invalid_argument("--segments needs a whole number from 2 to 1000");
-      out.segments = static_cast<int>(p);
-    } else if (a == "--solver") out.solver = parse_solver_kind(value());
+    else if (a == "--segments") out.segments = parse_int(a, value(), 2, 1000);
+    else if (a == "--solver") out.solver = parse_solver_kind(value());
     else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
     else if (need_session && out.session.empty()) out.session = a;
     else throw std::invalid_argument("unexpected argument \"" + a + "\"");
@@ -115,19 +100,9 @@ int simulate(const SimulateArgs& args) {
 }  // namespace
 
 int run_simulate(const std::vector<std::string>& args) {
-  for (const auto& a : args)
-    if (a == "--help" || a == "-h") {
-      std::cout << kSimulateUsage;
-      return 0;
-    }
-  SimulateArgs parsed;
-  try {
-    parsed = parse_simulate_args(args, true);
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "hapticjam simulate: " << e.what() << "\n" << kSimulateUsage;
-    return 2;
-  }
-  return simulate(parsed);
+  return run_subcommand<SimulateArgs>(
+      "simulate", kSimulateUsage, args, [](const std::vector<std::string>& a) { return parse_simulate_args(a, true); },
+      simulate);
 }
 
 int run_demo(const std::vector<std::string>& args) {
