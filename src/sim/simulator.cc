@@ -1,5 +1,6 @@
 #include "sim/simulator.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "sim/effect_registry.h"
@@ -41,7 +42,9 @@ void Simulator::settle() {
   if (last_.converged) return;
   // Safe fallback: relax dynamically from the previous state, then polish.
   state_.x = before;
-  const SettleReport dynamic = settle_explicit(model_, state_, options_.explicit_options);
+  ExplicitEulerOptions fallback = options_.explicit_options;
+  fallback.max_steps = std::min(fallback.max_steps, options_.fallback_max_steps);
+  const SettleReport dynamic = settle_explicit(model_, state_, fallback);
   last_ = settle_static(model_, state_, options_.static_options);
   last_.iterations += dynamic.iterations;
   last_.seconds += dynamic.seconds;

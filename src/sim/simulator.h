@@ -20,6 +20,9 @@ struct SimulatorOptions {
   SolverKind solver = SolverKind::kStatic;
   StaticSolverOptions static_options;
   ExplicitEulerOptions explicit_options;
+  // Steps the static solver's explicit fallback may take before the
+  // settle is reported as failed (bounds the time of a hard case).
+  long fallback_max_steps = 2'000'000;
   // Effects beyond the baseline, by registry name.
   std::vector<std::string> extra_effects;
 };
