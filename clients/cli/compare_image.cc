@@ -44,7 +44,7 @@ void write_compare_png(const std::filesystem::path& path, const Mesh& mesh, cons
   const Eigen::MatrixXd diff = predicted_mm - goal_mm;
   const double span = std::max(diff.cwiseAbs().maxCoeff(), 1e-9);
   char scale[96];
-  std::snprintf(scale, sizeof scale, "goal, predicted: %.1f..%.1f mm", lo, hi);
+  std::snprintf(scale, sizeof scale, "%.1f..%.1f mm, shared with predicted", lo, hi);
   char dscale[96];
   std::snprintf(dscale, sizeof dscale, "predicted - goal (+-%.1f mm)", span);
   std::vector<cv::Mat> panels = {titled(panel(mesh, goal_mm, lo, hi, cv::COLORMAP_VIRIDIS), std::string("goal (") + scale + ")"),

@@ -27,8 +27,9 @@ namespace {
 constexpr const char* kPlanUsage =
     "usage: hapticjam plan GOAL --rows R --cols C --out DIR [--segments P] [--planner NAME]\n"
     "                      [--max-height-mm H] [--region x0,y0,x1,y1] [--hue] [--json]\n"
+    "                      [--up-axis [-]x|y|z] [--view-resolution N]\n"
     "Plans the actions that make the display show GOAL (a height image: CSV, PNG,\n"
-    "TIFF) and writes DIR/plan.json (steps in the session format, correlation,\n"
+    "TIFF; or a mesh: STL, OBJ, PLY, glTF/GLB, 3MF, seen from above) and writes DIR/plan.json (steps in the session format, correlation,\n"
     "Laplace mean), DIR/predicted.csv and DIR/goal.csv (mm per mesh point, row i\n"
     "along +y) and DIR/compare.png.\n"
     "  --rows R, --cols C    array size in cells (38 mm cells)\n"
@@ -37,13 +38,16 @@ constexpr const char* kPlanUsage =
     "  --max-height-mm H     goal height range on the display (default 30 mm)\n"
     "  --region x0,y0,x1,y1  zoom: pixels, or fractions of the image if all <= 1\n"
     "  --hue                 colour topographic map: red-orange high, blue-purple low\n"
-    "  --json                print the summary as JSON\n";
+    "  --json                print the summary as JSON\n"
+    "  --up-axis A           a mesh's up axis: x, y, z (default), -x, -y or -z\n"
+    "  --view-resolution N   pixels of a mesh's top view along its longer side (default 256)\n";
 
 struct PlanArgs {
   std::string goal, out, planner = "algorithm2", region;
   int rows = 0, cols = 0, segments = 4;
   double max_height_mm = kDefaultMaxHeightMm;
   bool hue = false, json = false;
+  ImportOptions import;
 };
 
 PlanArgs parse_plan_args(const std::vector<std::string>& args) {
@@ -61,6 +65,15 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
     else if (a == "--planner") out.planner = value();
     else if (a == "--region") out.region = value();
     else if (a == "--hue") out.hue = true;
+    else if (a == "--view-resolution") out.import.mesh_resolution = parse_int(a, value(), 1, 8192);
+    else if (a == "--up-axis") {
+      std::string axis = value();
+      out.import.mesh_up_negative = !axis.empty() && axis[0] == '-';
+      if (out.import.mesh_up_negative) axis.erase(0, 1);
+      if (axis != "x" && axis != "y" && axis != "z")
+        throw std::invalid_argument("--up-axis needs x, y, z, -x, -y or -z, got \"" + axis + "\"");
+      out.import.mesh_up_axis = axis[0];
+    }
     else if (a == "--json") out.json = true;
     else if (a == "--max-height-mm") {
       out.max_height_mm = parse_number(a, value());
@@ -80,7 +93,9 @@ Eigen::MatrixXd as_image(const Eigen::MatrixXd& points) { return points.colwise(
 
 int plan(const PlanArgs& args) {
   const auto start = std::chrono::steady_clock::now();
-  HeightMap goal = import_goal(args.goal, ImportOptions{args.hue});
+  ImportOptions import = args.import;
+  import.hue = args.hue;
+  HeightMap goal = import_goal(args.goal, import);
   if (!args.region.empty()) goal = crop(goal, parse_region(args.region));
   const ArrayGeometry geometry{args.rows, args.cols, 0.038, args.segments};
   const Mesh mesh(geometry);

@@ -62,6 +62,12 @@ void ImportOptions::validate() const {
   if (max_pixels <= 0)
     throw std::invalid_argument("ImportOptions.max_pixels must be a positive pixel count, got " +
                                 std::to_string(max_pixels));
+  if (mesh_up_axis != 'x' && mesh_up_axis != 'y' && mesh_up_axis != 'z')
+    throw std::invalid_argument("ImportOptions.mesh_up_axis must be 'x', 'y' or 'z' (mesh_up_negative for -), got '" +
+                                std::string(1, mesh_up_axis) + "'");
+  if (mesh_resolution <= 0)
+    throw std::invalid_argument("ImportOptions.mesh_resolution must be a positive pixel count, got " +
+                                std::to_string(mesh_resolution));
 }
 
 void register_goal_importer(std::unique_ptr<GoalImporter> importer) {

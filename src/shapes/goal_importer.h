@@ -18,6 +18,13 @@ struct ImportOptions {
   bool hue = false;
   // Refuse images or tables with more values than this (memory guard).
   long max_pixels = 50'000'000;
+  // Meshes (mesh_importer.cc): the model axis that points up, 'x', 'y' or 'z',
+  // negated when mesh_up_negative; the mesh is rotated so it becomes +z.
+  char mesh_up_axis = 'z';
+  bool mesh_up_negative = false;
+  // Meshes: pixels along the longer horizontal side of the top view; its
+  // square must not exceed max_pixels.
+  int mesh_resolution = 256;
 
   // Throws std::invalid_argument naming the bad field.
   void validate() const;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,10 @@ struct HeightMap {
   // flipped by the caller (see the DEM's JSON, "north_up_numpy").
   Eigen::MatrixXd z;
   std::string source;  // where it came from, for messages: a path, plus any crop
+  // Height of the NaN pixels when fitting to an array, where they mean "no
+  // surface here" rather than "no data": a mesh's top view sets 0, the floor
+  // the part stands on. Unset (a DEM's no-data): take the nearest valid value.
+  std::optional<double> uncovered_height;
 };
 
 // A goal file that cannot be read. The message names the file and what is

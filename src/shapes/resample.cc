@@ -40,6 +40,8 @@ void check_goal(const HeightMap& goal, double max_height_mm) {
   if (goal.z.size() == 0) throw std::invalid_argument(name + " is empty");
   if (goal.z.array().isNaN().all()) throw std::invalid_argument(name + " has no valid (non-NaN) height");
   if (goal.z.array().isInf().any()) throw std::invalid_argument(name + " has an infinite height");
+  if (goal.uncovered_height && !std::isfinite(*goal.uncovered_height))
+    throw std::invalid_argument(name + " has a non-finite uncovered_height");
 }
 
 // For points whose footprint had no valid pixel (weight 0): the value of the
@@ -71,7 +73,10 @@ void fill_from_nearest(const Eigen::MatrixXd& z, const Eigen::MatrixXd& weight, 
 
 Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh, double max_height_mm) {
   check_goal(goal, max_height_mm);
-  const Eigen::MatrixXd& z = goal.z;  // (rows x cols), row 0 = top
+  // (rows x cols), row 0 = top; NaN that means "floor" becomes that height.
+  const Eigen::MatrixXd z = goal.uncovered_height
+                                ? Eigen::MatrixXd(goal.z.array().isNaN().select(*goal.uncovered_height, goal.z.array()))
+                                : goal.z;
   const long rows = z.rows(), cols = z.cols();
   const int n_i = mesh.point_rows(), n_j = mesh.point_cols();
   const auto along_x = footprints(n_j, cols);

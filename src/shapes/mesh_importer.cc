@@ -1,0 +1,98 @@
+// Mesh goal importer: Assimp reads the file, top_view.h renders it.
+#include "shapes/mesh_importer.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace hj {
+namespace {
+
+// Rotation taking the model's up direction to +z, as a map of one vertex.
+// Each case is a proper rotation (determinant +1), so handedness is kept.
+Eigen::Vector3d to_z_up(const aiVector3D& v, char axis, bool negative) {
+  const double x = v.x, y = v.y, z = v.z;
+  switch (axis) {
+    case 'x': return negative ? Eigen::Vector3d(y, -z, -x) : Eigen::Vector3d(y, z, x);
+    case 'y': return negative ? Eigen::Vector3d(x, z, -y) : Eigen::Vector3d(x, -z, y);
+    default: return negative ? Eigen::Vector3d(x, -y, -z) : Eigen::Vector3d(x, y, z);
+  }
+}
+
+long count_triangles(const aiScene& scene) {
+  long n = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m)
+    for (unsigned f = 0; f < scene.mMeshes[m]->mNumFaces; ++f) n += scene.mMeshes[m]->mFaces[f].mNumIndices == 3;
+  return n;
+}
+
+class MeshImporter final : public GoalImporter {
+ public:
+  std::string name() const override { return "mesh"; }
+  std::vector<std::string> extensions() const override { return {".3mf", ".glb", ".gltf", ".obj", ".ply", ".stl"}; }
+
+  HeightMap import(const std::filesystem::path& file, const ImportOptions& options) const override {
+    // Memory guard: the grid is at most mesh_resolution pixels square.
+    if (double(options.mesh_resolution) * options.mesh_resolution > double(options.max_pixels))
+      throw ImportError(file, "a " + std::to_string(options.mesh_resolution) + " pixel square top view (ImportOptions." +
+                                  "mesh_resolution) is over the limit of " + std::to_string(options.max_pixels) +
+                                  " pixels (ImportOptions.max_pixels)");
+    const std::vector<Triangle3d> triangles = load_mesh_triangles(file, options);
+    TopView view;
+    try {
+      view = render_top_view(triangles, options.mesh_resolution);
+    } catch (const std::invalid_argument& e) {
+      throw ImportError(file, std::string("seen from its up axis (ImportOptions.mesh_up_axis), ") + e.what());
+    }
+    if (view.z.array().isNaN().all())
+      throw ImportError(file, "no surface is seen from above (every triangle is edge-on to ImportOptions.mesh_up_axis)");
+    // Lowest visible surface = 0; NaN (uncovered) is skipped by the min.
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    const double lowest = view.z.array().isNaN().select(kInf, view.z.array()).minCoeff();
+    HeightMap map;
+    map.z = view.z.array() - lowest;
+    map.source = file.string();
+    map.uncovered_height = 0.0;  // around the part: the floor, as low as its lowest visible surface
+    return map;
+  }
+};
+
+}  // namespace
+
+std::vector<Triangle3d> load_mesh_triangles(const std::filesystem::path& file, const ImportOptions& options) {
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(
+      file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices);
+  if (scene == nullptr) throw ImportError(file, std::string("Assimp cannot read it: ") + importer.GetErrorString());
+  if (scene->mNumMeshes == 0) throw ImportError(file, "it holds no meshes");
+  const long n = count_triangles(*scene);
+  if (n == 0) throw ImportError(file, "it holds no triangles (only points or lines)");
+  if (n > kMaxMeshTriangles)
+    throw ImportError(file, std::to_string(n) + " triangles is over the limit of " + std::to_string(kMaxMeshTriangles));
+
+  // Every triangle, rotated so the chosen up axis is +z.
+  std::vector<Triangle3d> triangles;
+  triangles.reserve(size_t(n));
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene->mMeshes[m];
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      Triangle3d& t = triangles.emplace_back();
+      for (int k = 0; k < 3; ++k) {
+        t[k] = to_z_up(mesh.mVertices[face.mIndices[k]], options.mesh_up_axis, options.mesh_up_negative);
+        if (!t[k].allFinite())
+          throw ImportError(file, "a vertex of mesh " + std::to_string(m) + " has a non-finite coordinate");
+      }
+    }
+  }
+  return triangles;
+}
+
+HJ_REGISTER_GOAL_IMPORTER(MeshImporter);
+
+}  // namespace hj
