@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "expect_error.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -82,17 +84,7 @@ inline void expect_same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   }
 }
 
-// Expects fn to throw E whose message holds every word.
-template <typename E>
-void expect_error(const std::function<void()>& fn, const std::vector<std::string>& words) {
-  try {
-    fn();
-    ADD_FAILURE() << "no exception; expected one naming \"" << words.front() << "\"";
-  } catch (const E& e) {
-    const std::string what = e.what();
-    for (const auto& w : words) EXPECT_NE(what.find(w), std::string::npos) << "\"" << w << "\" not in: " << what;
-  }
-}
+using testing_support::expect_error;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 inline double nan_max(const Eigen::MatrixXd& z) { return z.array().isNaN().select(-kInf, z.array()).maxCoeff(); }

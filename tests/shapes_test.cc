@@ -3,6 +3,8 @@
 // interest, and resampling onto the paper's mesh (orientation, scaling).
 #include <gtest/gtest.h>
 
+#include "expect_error.h"
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -47,17 +49,7 @@ void expect_same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
     }
 }
 
-// Expects fn to throw E whose message holds every word.
-template <typename E>
-void expect_error(const std::function<void()>& fn, const std::vector<std::string>& words) {
-  try {
-    fn();
-    ADD_FAILURE() << "no exception; expected one naming \"" << words.front() << "\"";
-  } catch (const E& e) {
-    const std::string what = e.what();
-    for (const auto& w : words) EXPECT_NE(what.find(w), std::string::npos) << "\"" << w << "\" not in: " << what;
-  }
-}
+using testing_support::expect_error;
 
 void expect_import_error(const std::filesystem::path& file, const std::vector<std::string>& words,
                          const ImportOptions& options = {}) {
