@@ -84,7 +84,6 @@ inline void expect_same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   }
 }
 
-using testing_support::expect_error;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 inline double nan_max(const Eigen::MatrixXd& z) { return z.array().isNaN().select(-kInf, z.array()).maxCoeff(); }
