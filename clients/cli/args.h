@@ -15,7 +15,25 @@ double parse_number(const std::string& flag, const std::string& text);
 // A whole number in [lo, hi]; std::invalid_argument naming the flag otherwise.
 int parse_int(const std::string& flag, const std::string& text, int lo, int hi);
 
-// Prints usage for --help (exit 0); runs parse_and_run, turning its
+// Walks a subcommand's arguments: for (ArgCursor c(args); c.next();) reads
+// c.arg(), and c.value() takes the one after an option or names the option
+// that lacks it.
+class ArgCursor {
+ public:
+  explicit ArgCursor(const std::vector<std::string>& args) : args_(args) {}
+  bool next() { return ++i_ < args_.size(); }
+  const std::string& arg() const { return args_[i_]; }
+  const std::string& value() {
+    if (i_ + 1 >= args_.size()) throw std::invalid_argument(arg() + " needs a value");
+    return args_[++i_];
+  }
+
+ private:
+  const std::vector<std::string>& args_;
+  size_t i_ = static_cast<size_t>(-1);
+};
+
+// Prints usage for --help (exit 0); runs parse then run, turning its
 // std::invalid_argument from parsing into a usage error (exit 2). parse
 // must throw only on bad arguments; run's own errors propagate.
 template <class Args>

@@ -52,12 +52,9 @@ struct PlanArgs {
 
 PlanArgs parse_plan_args(const std::vector<std::string>& args) {
   PlanArgs out;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
-      return args[++i];
-    };
+  for (ArgCursor cursor(args); cursor.next();) {
+    const std::string& a = cursor.arg();
+    auto value = [&]() -> const std::string& { return cursor.value(); };
     if (a == "--out") out.out = value();
     else if (a == "--rows") out.rows = parse_int(a, value(), 1, 1000);
     else if (a == "--cols") out.cols = parse_int(a, value(), 1, 1000);

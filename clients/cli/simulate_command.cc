@@ -40,12 +40,9 @@ struct SimulateArgs {
 
 SimulateArgs parse_simulate_args(const std::vector<std::string>& args, bool need_session) {
   SimulateArgs out;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
-      return args[++i];
-    };
+  for (ArgCursor cursor(args); cursor.next();) {
+    const std::string& a = cursor.arg();
+    auto value = [&]() -> const std::string& { return cursor.value(); };
     if (a == "--out") out.out = value();
     else if (a == "--mass") out.mass_kg = parse_number(a, value());
     else if (a == "--k") out.spring_k = parse_number(a, value());

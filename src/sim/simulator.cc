@@ -59,7 +59,10 @@ const SettleReport& Simulator::apply(const Action& action) {
       state_.pressure_pa = action.pressure_pa;
       break;
     case Action::Op::kJam:
-      if (state_.jammed(m, action.a, action.b)) return last_ = SettleReport{true}, last_;
+      if (state_.jammed(m, action.a, action.b)) {  // already jammed: nothing changes
+        last_ = SettleReport{true};
+        return last_;
+      }
       state_.cell_jammed[m.cell_index(action.a, action.b)] = 1;
       // The cell keeps the bend it has now: phi_eq = phi.
       for (int p : m.cell_interior(action.a, action.b))

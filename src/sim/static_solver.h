@@ -2,11 +2,13 @@
 // force residual, each regularised as an implicit step of the overdamped
 // flow c dx/dt = F(x),
 //   (K + mu I) dx = F,   K = -dF/dx (analytic, sparse), mu = c / dt,
-// with mu shrinking as the residual falls (switched evolution relaxation),
 // so it starts as a heavily damped relaxation from the previous state and
-// ends as Newton. A converged state whose symmetric stiffness is not
-// positive definite (a saddle, or the creased net near levelling) is pushed
-// along its unstable mode and settled again.
+// ends as Newton. mu follows one of two controls (static_solver.cc): a fast
+// one that keeps each move near the cap, tried first, and a careful one that
+// shrinks mu only while the linear model predicts the residual. A converged
+// state whose symmetric stiffness is not positive definite (a saddle, or the
+// creased net near levelling) is pushed along its unstable mode and settled
+// again.
 #pragma once
 
 #include "model/device_state.h"

@@ -3,6 +3,8 @@
 // Run: ./build/hj_bench --benchmark_filter=Settle
 #include <benchmark/benchmark.h>
 
+#include <functional>
+
 #include "sim/simulator.h"
 
 namespace {
@@ -12,8 +14,10 @@ using hj::ArrayGeometry;
 using hj::SimulatorOptions;
 using hj::SolverKind;
 
-// args: rows, cols, segments, solver (0 static, 1 explicit)
-void BM_SettleRestTo2kPa(benchmark::State& state) {
+// Times one action on a simulator that `prepare` brought to its start
+// state (untimed). args: rows, cols, segments, solver (0 static, 1 explicit).
+void time_one_action(benchmark::State& state, const std::function<void(hj::Simulator&)>& prepare,
+                     const Action& action) {
   const ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038,
                         static_cast<int>(state.range(2))};
   SimulatorOptions options;
@@ -22,27 +26,26 @@ void BM_SettleRestTo2kPa(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
     hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
+    prepare(sim);
     state.ResumeTiming();
-    iterations += sim.apply(Action::set_pressure(2000.0)).iterations;
+    iterations += sim.apply(action).iterations;
   }
-  state.counters["solver_iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+  state.counters["solver_iterations"] =
+      benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+}
+
+void BM_SettleRestTo2kPa(benchmark::State& state) {
+  time_one_action(state, [](hj::Simulator&) {}, Action::set_pressure(2000.0));
 }
 
 void BM_SettleOneActionAfter2kPa(benchmark::State& state) {
-  const ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038,
-                        static_cast<int>(state.range(2))};
-  SimulatorOptions options;
-  options.solver = state.range(3) == 0 ? SolverKind::kStatic : SolverKind::kExplicit;
-  long iterations = 0;
-  for (auto _ : state) {
-    state.PauseTiming();
-    hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
-    sim.apply(Action::set_pressure(2000.0));
-    sim.apply(Action::jam(1, 1));
-    state.ResumeTiming();
-    iterations += sim.apply(Action::set_pressure(1000.0)).iterations;
-  }
-  state.counters["solver_iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+  time_one_action(
+      state,
+      [](hj::Simulator& sim) {
+        sim.apply(Action::set_pressure(2000.0));
+        sim.apply(Action::jam(1, 1));
+      },
+      Action::set_pressure(1000.0));
 }
 
 BENCHMARK(BM_SettleRestTo2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
