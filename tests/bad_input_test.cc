@@ -110,6 +110,18 @@ TEST(BadInput, UnknownEffectListsTheKnownOnes) {
                  {"strain-softening"});
 }
 
+TEST(BadInput, EffectParametersAreNamedAndBounded) {
+  const EffectInfo& gravity = EffectRegistry::instance().get("gravity");
+  EXPECT_EQ(resolve_parameters(gravity, {}).at("mass_kg"), 0.55);
+  EXPECT_EQ(resolve_parameters(gravity, {{"mass_kg", 2.0}}).at("mass_kg"), 2.0);
+  expect_invalid([&] { (void)resolve_parameters(gravity, {{"weight", 1.0}}); }, {"gravity.weight", "mass_kg"});
+  expect_invalid([&] { (void)resolve_parameters(gravity, {{"mass_kg", 1000.0}}); },
+                 {"gravity.mass_kg", "1000", "kg", "100"});
+  expect_invalid([&] { (void)resolve_parameters(gravity, {{"mass_kg", kNaN}}); }, {"gravity.mass_kg", "nan"});
+  expect_invalid([] { (void)make_effects({"gravity"}, {}); }, {"gravity", "twice"});
+  expect_invalid([] { (void)make_effects({}, {{"no-such-effect", {}}}); }, {"no-such-effect", "not switched on"});
+}
+
 TEST(BadInput, UnknownSolverName) {
   expect_invalid([] { parse_solver_kind("fast"); }, {"fast", "static", "explicit"});
   EXPECT_EQ(parse_solver_kind("static"), SolverKind::kStatic);

@@ -218,7 +218,7 @@ TEST(JammingForce, RestoresThroughTheFlatState) {
   const Mesh mesh(kPaper);
   const SurfaceParameters params = SurfaceParameters::paper_defaults(kPaper);
   std::vector<std::unique_ptr<Effect>> effects;
-  effects.push_back(EffectRegistry::instance().get("jamming").make());
+  effects.push_back(EffectRegistry::instance().get("jamming").make({}));
   const ForceModel model(mesh, params, std::move(effects));
   DeviceState state = DeviceState::flat(mesh);
   state.cell_jammed[mesh.cell_index(1, 1)] = 1;  // phi_eq = 0: jammed flat

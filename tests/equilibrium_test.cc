@@ -92,8 +92,8 @@ TEST(InternalForces, SumToZeroForceAndTorque) {
   const Mesh mesh(kPaper);
   const SurfaceParameters params = SurfaceParameters::paper_defaults(kPaper);
   std::vector<std::unique_ptr<Effect>> internal;
-  internal.push_back(EffectRegistry::instance().get("springs").make());
-  internal.push_back(EffectRegistry::instance().get("jamming").make());
+  internal.push_back(EffectRegistry::instance().get("springs").make({}));
+  internal.push_back(EffectRegistry::instance().get("jamming").make({}));
   const ForceModel model(mesh, params, std::move(internal));
   std::mt19937 rng(20240611);
   const DeviceState state = random_jammed_state(mesh, rng);

@@ -1,5 +1,7 @@
 // hapticjam: the command-line tool.
+#include <algorithm>
 #include <exception>
+#include <functional>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -8,6 +10,18 @@
 #include "simulate_command.h"
 
 namespace {
+
+struct Command {
+  const char* name;
+  std::function<int(const std::vector<std::string>&)> run;
+};
+
+// One line per subcommand; each lives in its own *_command.cc.
+const std::vector<Command> kCommands = {
+    {"simulate", hj::cli::run_simulate},
+    {"demo", hj::cli::run_demo},
+    {"plan", hj::cli::run_plan},
+};
 
 constexpr const char* kUsage =
     "usage: hapticjam COMMAND [ARGS]\n"
@@ -23,9 +37,8 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + std::min(argc, 2), argv + argc);
   const std::string command = argc > 1 ? argv[1] : "";
   try {
-    if (command == "simulate") return hj::cli::run_simulate(args);
-    if (command == "demo") return hj::cli::run_demo(args);
-    if (command == "plan") return hj::cli::run_plan(args);
+    for (const auto& c : kCommands)
+      if (command == c.name) return c.run(args);
     if (command == "--help" || command == "-h" || command == "help") {
       std::cout << kUsage;
       return 0;

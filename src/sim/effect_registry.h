@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,6 +22,10 @@ struct ParameterSpec {
   double upper = 0.0;
 };
 
+// Values of one effect's parameters by ParameterSpec::name (unqualified,
+// e.g. "kappa_bend"). resolve_parameters() fills in the defaults.
+using EffectParameterValues = std::map<std::string, double>;
+
 struct EffectInfo {
   std::string name;
   std::string description;
@@ -28,8 +33,15 @@ struct EffectInfo {
   // Parameters the effect reads. Baseline effects read theirs from
   // SurfaceParameters, named by field.
   std::vector<ParameterSpec> parameters;
-  std::function<std::unique_ptr<Effect>()> make;
+  // Builds the effect with every parameter given (resolved values). Baseline
+  // effects ignore the map and read SurfaceParameters.
+  std::function<std::unique_ptr<Effect>(const EffectParameterValues&)> make;
 };
+
+// `given` completed with the defaults of `info`. Throws std::invalid_argument
+// naming "effect.parameter" for an unknown name, a non-finite value or one
+// outside [lower, upper] (with the bounds and unit).
+EffectParameterValues resolve_parameters(const EffectInfo& info, const EffectParameterValues& given);
 
 class EffectRegistry {
  public:
@@ -47,6 +59,14 @@ class EffectRegistry {
 
 // The baseline model of docs/model.md, in its fixed order.
 std::vector<std::unique_ptr<Effect>> make_baseline_effects();
+
+// The baseline followed by `extra` (registry names, each at most once), each
+// built with its entry of `values` (effect name -> parameter values; missing
+// parameters take their defaults). Throws std::invalid_argument for an
+// unknown or repeated effect, values for an effect not in `extra`, or a bad
+// value (see resolve_parameters).
+std::vector<std::unique_ptr<Effect>> make_effects(const std::vector<std::string>& extra,
+                                                  const std::map<std::string, EffectParameterValues>& values);
 
 namespace detail {
 struct EffectRegistration {

@@ -8,16 +8,6 @@
 
 namespace hj {
 
-namespace {
-
-std::vector<std::unique_ptr<Effect>> build_effects(const std::vector<std::string>& extra) {
-  auto effects = make_baseline_effects();
-  for (const auto& name : extra) effects.push_back(EffectRegistry::instance().get(name).make());
-  return effects;
-}
-
-}  // namespace
-
 SolverKind parse_solver_kind(const std::string& name) {
   if (name == "static") return SolverKind::kStatic;
   if (name == "explicit") return SolverKind::kExplicit;
@@ -25,7 +15,7 @@ SolverKind parse_solver_kind(const std::string& name) {
 }
 
 Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& params, SimulatorOptions options)
-    : options_(std::move(options)), model_(Mesh(geometry), params, build_effects(options_.extra_effects)) {
+    : options_(std::move(options)), model_(Mesh(geometry), params, make_effects(options_.extra_effects, options_.effect_parameters)) {
   options_.static_options.validate();
   options_.explicit_options.validate();
   state_ = DeviceState::flat(model_.mesh());

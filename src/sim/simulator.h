@@ -3,11 +3,13 @@
 // (docs/model.md, "States and actions").
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "model/action.h"
+#include "sim/effect_registry.h"
 #include "sim/explicit_euler.h"
 #include "sim/force_model.h"
 #include "sim/static_solver.h"
@@ -23,8 +25,10 @@ struct SimulatorOptions {
   // Steps the static solver's explicit fallback may take before the
   // settle is reported as failed (bounds the time of a hard case).
   long fallback_max_steps = 2'000'000;
-  // Effects beyond the baseline, by registry name.
+  // Effects beyond the baseline, by registry name, and their parameter
+  // values (effect name -> parameter name -> value; missing = default).
   std::vector<std::string> extra_effects;
+  std::map<std::string, EffectParameterValues> effect_parameters;
 };
 
 class Simulator {

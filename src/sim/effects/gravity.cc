@@ -22,7 +22,7 @@ class Gravity final : public Effect {
 
 HJ_REGISTER_EFFECT(EffectInfo{"gravity", "weight m g of each point, m = M / N", true,
                               {{"mass_kg", "kg", 0.55, 0.01, 100.0}},
-                              [] { return std::make_unique<Gravity>(); }});
+                              [](const EffectParameterValues&) { return std::make_unique<Gravity>(); }});
 
 }  // namespace
 }  // namespace hj

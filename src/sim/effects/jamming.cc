@@ -65,7 +65,7 @@ class Jamming final : public Effect {
 
 HJ_REGISTER_EFFECT(EffectInfo{"jamming", "torsional springs kappa_jam in jammed cells, signed bend angle (Eq. 5-11)",
                               true, {{"kappa_jam", "N m/rad", 4.79, 0.0, 100.0}},
-                              [] { return std::make_unique<Jamming>(); }});
+                              [](const EffectParameterValues&) { return std::make_unique<Jamming>(); }});
 
 }  // namespace
 }  // namespace hj

@@ -36,7 +36,7 @@ class Pressure final : public Effect {
 };
 
 HJ_REGISTER_EFFECT(EffectInfo{"pressure", "chamber pressure P A_spp along the Eq. 3 normal", true, {},
-                              [] { return std::make_unique<Pressure>(); }});
+                              [](const EffectParameterValues&) { return std::make_unique<Pressure>(); }});
 
 }  // namespace
 }  // namespace hj

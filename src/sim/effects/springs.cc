@@ -78,7 +78,7 @@ class Springs final : public Effect {
 HJ_REGISTER_EFFECT(EffectInfo{
     "springs", "structural springs between 4-neighbours with dampers along them (Eq. 1-2)", true,
     {{"spring_k", "N/m", 64.5, 1.0, 1000.0}, {"damping_b", "N s/m", 0.5, 0.0, 100.0}},
-    [] { return std::make_unique<Springs>(); }});
+    [](const EffectParameterValues&) { return std::make_unique<Springs>(); }});
 
 }  // namespace
 }  // namespace hj
