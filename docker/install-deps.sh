@@ -8,7 +8,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev libboost-system-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
-  libopencv-dev libassimp-dev libsqlite3-dev
+  libopencv-dev libassimp-dev libsqlite3-dev libgdal-dev libceres-dev
+  python3 python3-grpcio python3-protobuf
 )
 missing=()
 for p in "${packages[@]}"; do
