@@ -1,0 +1,39 @@
+// Solves the regularised Newton system (K + mu I) dx = r of the static
+// solver. While mu is large (the damped, flow-like start of a settle) the
+// shifted matrix is diagonally dominant and Jacobi-preconditioned BiCGSTAB
+// converges in a few dozen products, an order of magnitude cheaper than a
+// sparse LU on a 9 x 12 array; as mu falls towards Newton it stops
+// converging within its budget and the solve switches to UMFPACK's LU
+// (factorised only when needed).
+#pragma once
+
+#include <Eigen/SparseCore>
+#include <memory>
+
+namespace hj {
+
+class ShiftedSolver {
+ public:
+  ShiftedSolver();
+  ~ShiftedSolver();
+  ShiftedSolver(const ShiftedSolver&) = delete;
+  ShiftedSolver& operator=(const ShiftedSolver&) = delete;
+
+  // a = K + mu I over the free DOFs (pattern fixed between calls). Returns
+  // false if no solve succeeded (a singular a); dx is then unspecified.
+  bool solve(const Eigen::SparseMatrix<double>& a, double mu, const Eigen::VectorXd& r, Eigen::VectorXd& dx);
+
+  int iterative_solves() const { return iterative_solves_; }
+  int direct_solves() const { return direct_solves_; }
+
+ private:
+  struct Direct;
+  std::unique_ptr<Direct> direct_;
+  // The smallest mu at which the iterative solve last failed: below it (and
+  // a little above) go straight to the LU.
+  double failed_mu_ = 0.0;
+  int iterative_solves_ = 0;
+  int direct_solves_ = 0;
+};
+
+}  // namespace hj
