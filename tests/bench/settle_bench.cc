@@ -3,6 +3,7 @@
 // Run: ./build/hj_bench --benchmark_filter=Settle
 #include <benchmark/benchmark.h>
 
+#include <exception>
 #include <functional>
 
 #include "sim/simulator.h"
@@ -28,7 +29,13 @@ void time_one_action(benchmark::State& state, const std::function<void(hj::Simul
     hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
     prepare(sim);
     state.ResumeTiming();
-    iterations += sim.apply(action).iterations;
+    try {
+      iterations += sim.apply(action).iterations;
+    } catch (const std::exception& e) {
+      // A hard case the solver gives up on is a result, not a crash.
+      state.SkipWithError(e.what());
+      break;
+    }
   }
   state.counters["solver_iterations"] =
       benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
@@ -49,8 +56,10 @@ void BM_SettleOneActionAfter2kPa(benchmark::State& state) {
 }
 
 BENCHMARK(BM_SettleRestTo2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_SettleOneActionAfter2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
-// The slow ones, run by name: 9 x 12 explicit, and p = 10.
+BENCHMARK(BM_SettleOneActionAfter2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(3);
+// The slow ones, run by name: 9 x 12 explicit, p = 10, and the 9 x 12 jammed
+// step (2 -> 1 kPa), which the static solver does not yet settle (issue 2).
 BENCHMARK(BM_SettleRestTo2kPa)->Name("Slow/BM_SettleRestTo2kPa")->Args({9, 12, 4, 1})->Args({9, 12, 10, 0})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_SettleOneActionAfter2kPa)->Name("Slow/BM_SettleOneActionAfter2kPa")->Args({9, 12, 4, 0})->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
