@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <ostream>
 #include <random>
 #include <string>
 
@@ -26,6 +27,8 @@ struct Case {
   std::string label;   // test name suffix
   bool active = true;  // false where the values make the effect a no-op
 };
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.effect << " " << c.label; }
 
 // Settled once for all cases: 2 kPa, three jammed cells, a pin.
 const Simulator& jammed_device() {

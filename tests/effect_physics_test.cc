@@ -55,6 +55,8 @@ struct NoOp {
   EffectParameterValues values;
 };
 
+void PrintTo(const NoOp& c, std::ostream* os) { *os << c.effect; }
+
 class EffectAtNoOpValues : public testing::TestWithParam<NoOp> {};
 
 TEST_P(EffectAtNoOpValues, ChangesNothing) {
