@@ -23,6 +23,19 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
 }
 
 void Simulator::settle() {
+  settle_once();
+  // Effects that change the state at equilibrium (jam creep) do so once per
+  // settle; the surface then settles to the changed state.
+  if (last_.converged && model_.after_settle(state_)) {
+    const SettleReport first = last_;
+    settle_once();
+    last_.iterations += first.iterations;
+    last_.seconds += first.seconds;
+    last_.restarts += first.restarts;
+  }
+}
+
+void Simulator::settle_once() {
   if (options_.solver == SolverKind::kExplicit) {
     last_ = settle_explicit(model_, state_, options_.explicit_options);
     return;

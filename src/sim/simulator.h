@@ -49,7 +49,10 @@ class Simulator {
   const SettleReport& apply(const Action& action);
 
  private:
+  // Settles, then runs the effects' after_settle hooks (ForceModel) and,
+  // if they changed the state, settles once more.
   void settle();
+  void settle_once();
 
   SimulatorOptions options_;
   ForceModel model_;
