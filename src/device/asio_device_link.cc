@@ -96,7 +96,11 @@ struct AsioDeviceLink::Impl {
   }
 
   void connect() {
-    const unsigned gen = ++generation;
+    unsigned gen = 0;
+    {
+      std::lock_guard lock(mutex);
+      gen = ++generation;
+    }
     connect_timer.expires_after(options.connect_timeout);
     connect_timer.async_wait([this, gen](boost::system::error_code ec) {
       if (!ec && gen == generation) fail(gen, "no hello within " + std::to_string(ms(options.connect_timeout)) + " ms");
@@ -215,7 +219,7 @@ struct AsioDeviceLink::Impl {
   }
 
   void write(unsigned gen, std::string line) {
-    if (gen != generation) return;
+    if (gen != generation || (!socket && !serial)) return;
     write_queue.push_back(std::move(line));
     if (write_queue.size() == 1) write_next(gen);
   }
@@ -286,18 +290,20 @@ struct AsioDeviceLink::Impl {
   // the callback if it was up, and try again after the backoff.
   void fail(unsigned gen, const std::string& reason) {
     if (gen != generation) return;
-    ++generation;
-    close();
     bool was_up = false;
     bool stop_now = false;
     {
+      // With `up`, so a caller that saw the link up holds this connection's
+      // generation, never the next one's.
       std::lock_guard lock(mutex);
+      ++generation;
       was_up = up;
       up = false;
       status.connected = false;
       status.last_error = "link: " + reason;
       stop_now = stopping;
     }
+    close();
     fail_pending(reason);
     if (stop_now) return;
     if (was_up) notify(false);
@@ -383,14 +389,14 @@ void AsioDeviceLink::stop() {
   }
   asio::post(impl_->io, [this] {
     Impl& d = *impl_;
-    ++d.generation;
-    d.close();
-    d.reconnect_timer.cancel();
     {
       std::lock_guard lock(d.mutex);
+      ++d.generation;
       d.up = false;
       d.status.connected = false;
     }
+    d.close();
+    d.reconnect_timer.cancel();
     d.fail_pending("the link was stopped");
     d.io.stop();
   });

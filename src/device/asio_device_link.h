@@ -30,8 +30,12 @@ class AsioDeviceLink final : public DeviceLink {
   void execute(const Action& action, std::chrono::milliseconds timeout) override;
   Capture capture(std::chrono::milliseconds timeout) override;
   void vent(std::chrono::milliseconds timeout) override;
-  // The device's state as last reported or acknowledged (no I/O).
+  // The device's state as last reported or acknowledged (no I/O);
+  // last_error is the most recent failure (kept after a reconnect).
   DeviceStatus status() const override;
+  // Callbacks run in order on a thread of the link's own (not the one doing
+  // I/O), so one may send commands itself, e.g. vent() on reconnect; it must
+  // not call stop().
   void on_connection_change(std::function<void(bool connected)> callback) override;
 
   // Asks the device for its state ("status"), refreshes status() and
