@@ -2,8 +2,14 @@
 // surface it captures is the simulator's, status and vent tell and make the
 // true state, and every failure (refusal, stall, drop, mute device, no
 // device) comes back as the right DeviceError without hanging.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <thread>
 
@@ -263,6 +269,90 @@ TEST_F(DeviceLinkTest, ACallbackMayVentOnReconnect) {
   ASSERT_TRUE(eventually([&] { return vented == 2; }));
   EXPECT_EQ(link->query_status(kLong).pressure_pa, 0.0);
   link->stop();
+}
+
+TEST_F(DeviceLinkTest, StopThenStartConnectsAgain) {
+  EmulatedDevice device;
+  connect(device);
+  link->stop();
+  EXPECT_FALSE(link->connected());
+  EXPECT_EQ(kind_of([&] { link->ping(kLong); }), DeviceError::Kind::kDisconnected);
+  link->start();
+  ASSERT_TRUE(events.reach(2));
+  EXPECT_EQ(events.events(), (std::vector<bool>{true, true}));  // no callback from stop()
+  link->ping(kLong);
+}
+
+// A "device" on a plain socket that answers the first line of every
+// connection with `reply`, then hangs up.
+class ScriptedDevice {
+ public:
+  explicit ScriptedDevice(std::string reply) : reply_(std::move(reply)) {
+    listener_ = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t size = sizeof address;
+    if (bind(listener_, reinterpret_cast<sockaddr*>(&address), size) != 0 || listen(listener_, 8) != 0 ||
+        getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &size) != 0)
+      throw std::runtime_error("scripted device cannot listen");
+    port_ = ntohs(address.sin_port);
+    thread_ = std::thread([this] {
+      while (true) {
+        const int c = accept(listener_, nullptr, nullptr);
+        if (c < 0 || stop_) {
+          if (c >= 0) close(c);
+          return;
+        }
+        ++connections;
+        char buffer[256];
+        const ssize_t n = read(c, buffer, sizeof buffer);
+        if (n > 0) {
+          // "ID" in the script becomes the id of the request (the hello).
+          std::string reply = reply_;
+          const std::string id(buffer, std::find(buffer, buffer + n, ' '));
+          if (const auto at = reply.find("ID"); at != std::string::npos) reply.replace(at, 2, id);
+          (void)!write(c, reply.data(), reply.size());
+        }
+        close(c);
+      }
+    });
+  }
+  ~ScriptedDevice() {
+    stop_ = true;
+    shutdown(listener_, SHUT_RDWR);  // wakes accept()
+    thread_.join();
+    close(listener_);
+  }
+  std::string endpoint() const { return "127.0.0.1:" + std::to_string(port_); }
+  std::atomic<int> connections{0};
+
+ private:
+  std::string reply_;
+  int listener_ = -1;
+  unsigned short port_ = 0;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+TEST_F(DeviceLinkTest, GarbageFromTheDeviceIsAFailedConnectionNotACrash) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"garbage\n", "bad reply: reply \"garbage\" starts with neither ok nor err"},
+      {"ok ID protocol=1 rows=x\n", "bad reply: hello: rows=\"x\" is not a whole number"},
+      {"ok ID protocol=9 rows=3 cols=4 cell_mm=38 max_pressure_pa=3450 grid=77,58,0,0,2,2\n",
+       "device speaks protocol 9, this link 1"},
+      {std::string(5000, '\x01') + "\n", "starts with neither ok nor err"},
+  };
+  for (const auto& [reply, error] : cases) {
+    SCOPED_TRACE(error);
+    ScriptedDevice liar(reply);
+    auto l = make_device_link(liar.endpoint(), fast_options());
+    l->start();
+    ASSERT_TRUE(eventually([&] { return liar.connections >= 2; }));  // refused, then tried again
+    EXPECT_FALSE(l->connected());
+    EXPECT_NE(l->status().last_error.find(error), std::string::npos) << l->status().last_error;
+    l->stop();
+  }
 }
 
 }  // namespace
