@@ -30,10 +30,17 @@ using Kind = DeviceError::Kind;
 
 namespace {
 
-// A command a caller waits for; the io thread fulfils or fails it.
+// How a command ended, as the io thread hands it to the waiting caller
+// (who builds any exception in its own thread).
+struct Outcome {
+  protocol::Reply reply;
+  std::string dropped;  // non-empty: the link dropped, and why
+};
+
+// A command a caller waits for; the io thread fulfils it.
 struct Pending {
   std::string what;  // the command as sent, for messages
-  std::promise<protocol::Reply> reply;
+  std::promise<Outcome> outcome;
 };
 
 long long ms(std::chrono::milliseconds d) { return static_cast<long long>(d.count()); }
@@ -220,7 +227,7 @@ struct AsioDeviceLink::Impl {
       }
     }
     // A reply whose caller has timed out is dropped.
-    if (waiting) waiting->reply.set_value(reply);
+    if (waiting) waiting->outcome.set_value({reply, ""});
   }
 
   void send_internal(unsigned gen, const std::string& command, std::function<void(const protocol::Reply&)> handler) {
@@ -296,7 +303,7 @@ struct AsioDeviceLink::Impl {
     for (auto& [id, p] : failed) {
       const std::string what =
           "device link to " + endpoint.to_string() + " dropped during \"" + p->what + "\": " + reason;
-      p->reply.set_exception(std::make_exception_ptr(DeviceError(Kind::kDisconnected, what)));
+      p->outcome.set_value({{}, what});
     }
   }
 
@@ -337,7 +344,7 @@ struct AsioDeviceLink::Impl {
     const std::uint64_t id = next_id++;
     auto p = std::make_shared<Pending>();
     p->what = command;
-    std::future<protocol::Reply> reply = p->reply.get_future();
+    std::future<Outcome> outcome = p->outcome.get_future();
     unsigned gen = 0;
     {
       std::lock_guard lock(mutex);
@@ -351,20 +358,23 @@ struct AsioDeviceLink::Impl {
     asio::post(io, [this, gen, line = std::to_string(id) + " " + command + "\n"]() mutable {
       write(gen, std::move(line));
     });
-    if (reply.wait_for(timeout) != std::future_status::ready) {
-      {
-        std::lock_guard lock(mutex);
-        // Fulfilled or failed just now by the io thread: take that instead.
-        if (pending.erase(id) == 0) return finish(command, reply.get());
-        status.last_error = "\"" + command + "\" timed out";
-      }
+    bool timed_out = false;
+    if (outcome.wait_for(timeout) != std::future_status::ready) {
+      std::lock_guard lock(mutex);
+      // Unless the io thread took it just now (then its outcome follows),
+      // give up on it; a late reply will find no one waiting.
+      timed_out = pending.erase(id) == 1;
+      if (timed_out) status.last_error = "\"" + command + "\" timed out";
+    }
+    if (timed_out)
       throw DeviceError(Kind::kTimeout, "device command \"" + command + "\" got no reply within " +
                                             std::to_string(ms(timeout)) + " ms");
-    }
-    return finish(command, reply.get());
+    return finish(command, outcome.get());
   }
 
-  protocol::Reply finish(const std::string& command, protocol::Reply reply) {
+  protocol::Reply finish(const std::string& command, Outcome outcome) {
+    if (!outcome.dropped.empty()) throw DeviceError(Kind::kDisconnected, outcome.dropped);
+    const protocol::Reply& reply = outcome.reply;
     if (reply.ok) return reply;
     const std::string what = "device refused \"" + command + "\": " + reply.code + ": " + reply.text;
     {
