@@ -80,7 +80,7 @@ struct AsioDeviceLink::Impl {
   std::array<char, 64 * 1024> read_buffer{};
   std::deque<std::string> write_queue;
   std::map<std::uint64_t, std::function<void(const protocol::Reply&)>> internal;  // hello, status, ping
-  Clock::time_point last_line;
+  Clock::time_point last_data;  // bytes of a long reply count as life too
   bool ping_outstanding = false;
   std::chrono::milliseconds backoff;
 
@@ -153,7 +153,7 @@ struct AsioDeviceLink::Impl {
 
   // The stream is open: say hello, read the state, then report "up".
   void opened(unsigned gen) {
-    last_line = Clock::now();
+    last_data = Clock::now();
     read(gen);
     send_internal(gen, "hello", [this, gen](const protocol::Reply& r) {
       if (!r.ok) return fail(gen, "hello refused: " + r.code + " " + r.text);
@@ -191,6 +191,7 @@ struct AsioDeviceLink::Impl {
       stream.async_read_some(asio::buffer(read_buffer), [this, gen](boost::system::error_code ec, std::size_t n) {
         if (gen != generation) return;
         if (ec) return fail(gen, ec == asio::error::eof ? "the device closed the connection" : ec.message());
+        last_data = Clock::now();
         try {
           lines.feed(
               std::string_view(read_buffer.data(), n), [&](std::string_view line) { received(gen, line); },
@@ -206,9 +207,7 @@ struct AsioDeviceLink::Impl {
   }
 
   void received(unsigned gen, std::string_view line) {
-    if (gen != generation) return;
-    last_line = Clock::now();
-    if (line.empty()) return;
+    if (gen != generation || line.empty()) return;
     const protocol::Reply reply = protocol::parse_reply(line);
     if (const auto it = internal.find(reply.id); it != internal.end()) {
       const auto handler = std::move(it->second);
@@ -258,8 +257,9 @@ struct AsioDeviceLink::Impl {
     heartbeat_timer.expires_after(options.heartbeat_interval);
     heartbeat_timer.async_wait([this, gen](boost::system::error_code ec) {
       if (ec || gen != generation) return;
-      if (Clock::now() - last_line > options.heartbeat_timeout)
-        return fail(gen, "no reply to the heartbeat for " + std::to_string(ms(options.heartbeat_timeout)) + " ms");
+      if (Clock::now() - last_data > options.heartbeat_timeout)
+        return fail(gen, "nothing received for " + std::to_string(ms(options.heartbeat_timeout)) +
+                             " ms (heartbeat)");
       if (!ping_outstanding) {
         ping_outstanding = true;
         send_internal(gen, "ping", [this](const protocol::Reply&) { ping_outstanding = false; });
