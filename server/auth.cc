@@ -1,0 +1,73 @@
+#include "auth.h"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "service_error.h"
+
+namespace hj::server {
+
+const char* role_name(Role role) {
+  switch (role) {
+    case Role::kPreview: return "preview";
+    case Role::kOperator: return "operator";
+    case Role::kAdmin: return "admin";
+  }
+  return "?";
+}
+
+namespace {
+
+Role parse_role(const std::string& text, const std::string& where) {
+  if (text == "preview") return Role::kPreview;
+  if (text == "operator") return Role::kOperator;
+  if (text == "admin") return Role::kAdmin;
+  throw std::invalid_argument(where + ": unknown role \"" + text + "\" (preview, operator or admin)");
+}
+
+}  // namespace
+
+Authenticator Authenticator::from_file(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw std::invalid_argument("cannot read auth file \"" + file.string() + "\"");
+  Authenticator auth;
+  auth.enabled_ = true;
+  std::set<std::string> names;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+    std::istringstream fields(line);
+    std::string name, role, token, extra;
+    if (!(fields >> name)) continue;
+    const std::string where = "auth file \"" + file.string() + "\" line " + std::to_string(number);
+    if (!(fields >> role >> token) || (fields >> extra))
+      throw std::invalid_argument(where + ": expected NAME ROLE TOKEN");
+    if (token.size() < 8) throw std::invalid_argument(where + ": token shorter than 8 characters");
+    if (!names.insert(name).second) throw std::invalid_argument(where + ": caller \"" + name + "\" given twice");
+    if (!auth.by_token_.emplace(token, Caller{name, parse_role(role, where)}).second)
+      throw std::invalid_argument(where + ": token of \"" + name + "\" already belongs to another caller");
+  }
+  if (auth.by_token_.empty()) throw std::invalid_argument("auth file \"" + file.string() + "\" names no caller");
+  return auth;
+}
+
+Caller Authenticator::authorize(const std::optional<std::string>& authorization, Role role,
+                                const std::string& action) const {
+  if (!enabled_) return Caller{"local", Role::kAdmin};
+  const std::string prefix = "Bearer ";
+  if (!authorization || authorization->rfind(prefix, 0) != 0)
+    throw ServiceError(grpc::StatusCode::UNAUTHENTICATED,
+                       "no bearer token: send metadata \"authorization: Bearer TOKEN\"");
+  const auto found = by_token_.find(authorization->substr(prefix.size()));
+  if (found == by_token_.end()) throw ServiceError(grpc::StatusCode::UNAUTHENTICATED, "unknown bearer token");
+  const Caller& caller = found->second;
+  if (caller.role < role)
+    throw ServiceError(grpc::StatusCode::PERMISSION_DENIED,
+                       "caller \"" + caller.name + "\" has role " + role_name(caller.role) + "; " + action +
+                           " needs " + role_name(role));
+  return caller;
+}
+
+}  // namespace hj::server

@@ -1,0 +1,106 @@
+#include "goal_source.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+#include <stdexcept>
+
+#include "proto_convert.h"
+#include "shapes/goal_importer.h"
+#include "shapes/region.h"
+
+namespace hj::server {
+
+namespace {
+
+// A file holding `bytes` under a unique name with the extension of
+// `file_name` (the importer picks the format by it), removed on destruction.
+class TemporaryGoalFile {
+ public:
+  TemporaryGoalFile(const std::string& bytes, const std::string& file_name) {
+    static std::atomic<long> counter{0};
+    const std::string extension = std::filesystem::path(file_name).extension().string();
+    path_ = std::filesystem::temp_directory_path() /
+            ("hj-goal-" + std::to_string(::getpid()) + "-" + std::to_string(++counter) + extension);
+    std::ofstream out(path_, std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    if (!out) throw std::runtime_error("cannot write the goal to a temporary file " + path_.string());
+  }
+  ~TemporaryGoalFile() {
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+HeightMap import_bytes(const hapticjam::v1::GoalFile& file, const ImportOptions& options) {
+  if (file.file_name().empty())
+    throw std::invalid_argument("goal.file.file_name is empty: its extension names the format (e.g. \"part.stl\")");
+  if (file.content().empty()) throw std::invalid_argument("goal.file.content is empty");
+  const TemporaryGoalFile temporary(file.content(), file.file_name());
+  try {
+    HeightMap map = import_goal(temporary.path(), options);
+    map.source = file.file_name();
+    return map;
+  } catch (const ImportError& e) {
+    // Name the client's file, not our temporary copy.
+    std::string what = e.what();
+    const std::string tmp = temporary.path().string();
+    for (auto at = what.find(tmp); at != std::string::npos; at = what.find(tmp))
+      what.replace(at, tmp.size(), file.file_name());
+    const std::string prefix = "cannot import goal \"" + file.file_name() + "\": ";
+    throw ImportError(file.file_name(), what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what);
+  }
+}
+
+}  // namespace
+
+void MapStore::add(const std::string& name, const std::filesystem::path& file, const ServerLimits& limits) {
+  if (name.empty()) throw std::invalid_argument("--map needs NAME=FILE, the name is empty");
+  if (maps_.count(name)) throw std::invalid_argument("--map \"" + name + "\" given twice");
+  ImportOptions options;
+  options.max_pixels = limits.max_goal_pixels;
+  maps_.emplace(name, import_goal(file, options));
+}
+
+const HeightMap* MapStore::find(const std::string& name) const {
+  const auto found = maps_.find(name);
+  return found == maps_.end() ? nullptr : &found->second;
+}
+
+std::vector<std::string> MapStore::names() const {
+  std::vector<std::string> out;
+  for (const auto& [name, map] : maps_) out.push_back(name);
+  return out;
+}
+
+HeightMap load_goal(const hapticjam::v1::Goal& goal, const MapStore& maps, const ServerLimits& limits) {
+  const ImportOptions options = import_options_from_proto(goal.options(), limits);
+  HeightMap map;
+  switch (goal.source_case()) {
+    case hapticjam::v1::Goal::kFile: map = import_bytes(goal.file(), options); break;
+    case hapticjam::v1::Goal::kMapName: {
+      const HeightMap* found = maps.find(goal.map_name());
+      if (!found) {
+        std::string known;
+        for (const auto& n : maps.names()) known += (known.empty() ? "" : ", ") + n;
+        throw std::invalid_argument("goal.map_name \"" + goal.map_name() + "\" is not a map of this server (known: " +
+                                    (known.empty() ? "none" : known) + ")");
+      }
+      map = *found;
+      break;
+    }
+    case hapticjam::v1::Goal::SOURCE_NOT_SET: throw std::invalid_argument("goal has neither file nor map_name");
+  }
+  if (goal.has_region()) {
+    const auto& r = goal.region();
+    map = crop(map, Region{r.x0(), r.y0(), r.x1(), r.y1(), !r.pixels()});
+  }
+  return map;
+}
+
+}  // namespace hj::server
