@@ -1,0 +1,137 @@
+#include "device/emulator.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "calib/rasterize.h"
+
+namespace hj::device {
+
+namespace {
+
+CaptureGrid to_capture_grid(const SessionGrid& g) { return {g.nx, g.ny, g.x0_mm, g.y0_mm, g.dx_mm, g.dy_mm}; }
+
+}  // namespace
+
+void CameraOptions::validate() const {
+  if (grid.nx < 1 || grid.ny < 1 || static_cast<long>(grid.nx) * grid.ny > protocol::kMaxCaptureSamples)
+    throw std::invalid_argument("camera grid of " + std::to_string(grid.nx) + " x " + std::to_string(grid.ny) +
+                                " samples: each side must be >= 1 and the total <= " +
+                                std::to_string(protocol::kMaxCaptureSamples));
+  if (!std::isfinite(grid.x0_mm) || !std::isfinite(grid.y0_mm))
+    throw std::invalid_argument("camera grid origin (mm) must be finite");
+  if (!(grid.dx_mm > 0.0) || !(grid.dy_mm > 0.0) || !std::isfinite(grid.dx_mm) || !std::isfinite(grid.dy_mm))
+    throw std::invalid_argument("camera grid spacing dx, dy (mm) must be positive");
+  if (!(noise_mm >= 0.0) || !std::isfinite(noise_mm))
+    throw std::invalid_argument("camera noise_mm (sigma, mm) must be finite and >= 0");
+  if (!(resolution_mm >= 0.0) || !std::isfinite(resolution_mm))
+    throw std::invalid_argument("camera resolution_mm (mm) must be finite and >= 0");
+  if (!(dropout >= 0.0 && dropout < 1.0)) throw std::invalid_argument("camera dropout (fraction) must be in [0, 1)");
+}
+
+SessionGrid default_capture_grid(const ArrayGeometry& geometry) {
+  const double step_mm = 2.0;
+  SessionGrid g;
+  g.dx_mm = g.dy_mm = step_mm;
+  // The floor of a whole number of steps, with room for rounding error.
+  g.nx = static_cast<int>(std::floor(geometry.cols * geometry.cell_size_m * 1000.0 / step_mm + 1e-9)) + 1;
+  g.ny = static_cast<int>(std::floor(geometry.rows * geometry.cell_size_m * 1000.0 / step_mm + 1e-9)) + 1;
+  return g;
+}
+
+Emulator::Emulator(EmulatorConfig config)
+    : config_((config.camera.validate(), std::move(config))),
+      simulator_(config_.geometry, config_.params, config_.simulator),
+      camera_random_(config_.camera.seed) {}
+
+protocol::Hello Emulator::hello() const {
+  protocol::Hello h;
+  h.rows = config_.geometry.rows;
+  h.cols = config_.geometry.cols;
+  h.cell_mm = config_.geometry.cell_size_m * 1000.0;
+  h.max_pressure_pa = config_.params.max_pressure_pa;
+  h.grid = to_capture_grid(config_.camera.grid);
+  return h;
+}
+
+std::string Emulator::handle(const protocol::Request& r) {
+  using protocol::Command;
+  switch (r.command) {
+    case Command::kHello: return protocol::format_ok(r.id, protocol::format_hello(hello()));
+    case Command::kPing: return protocol::format_ok(r.id);
+    case Command::kStatus: return protocol::format_ok(r.id, protocol::format_status(status()));
+    case Command::kCapture: return protocol::format_ok(r.id, protocol::format_capture(capture()));
+    case Command::kVent: return vent(r.id);
+    case Command::kAction: return act(r.id, r.action);
+    case Command::kFault: break;
+  }
+  return protocol::format_err(r.id, protocol::ErrorCode::kFailed, "faults are handled by the server, not the device");
+}
+
+std::string Emulator::act(std::uint64_t id, const Action& action) {
+  try {
+    simulator_.apply(action);
+  } catch (const std::invalid_argument& e) {
+    const auto code = action.op == Action::Op::kSetPressure ? protocol::ErrorCode::kUnsafe
+                                                            : protocol::ErrorCode::kOutOfRange;
+    return protocol::format_err(id, code, e.what());
+  } catch (const std::exception& e) {
+    return protocol::format_err(id, protocol::ErrorCode::kFailed, action.describe() + ": " + e.what());
+  }
+  return protocol::format_ok(id);
+}
+
+// The safe state, one action at a time as a controller would: pressure off,
+// then every pin released, then every cell unjammed.
+std::string Emulator::vent(std::uint64_t id) {
+  const Mesh& mesh = simulator_.mesh();
+  std::vector<Action> steps{Action::set_pressure(0.0)};
+  for (int a = 1; a < mesh.rows(); ++a)
+    for (int b = 1; b < mesh.cols(); ++b)
+      if (simulator_.state().pinned(mesh, a, b)) steps.push_back(Action::unpin(a, b));
+  for (int r = 0; r < mesh.rows(); ++r)
+    for (int c = 0; c < mesh.cols(); ++c)
+      if (simulator_.state().jammed(mesh, r, c)) steps.push_back(Action::unjam(r, c));
+  for (const Action& step : steps) {
+    const std::string reply = act(id, step);
+    if (reply.rfind("err", 0) == 0) return reply;
+  }
+  return protocol::format_ok(id);
+}
+
+protocol::StatusPayload Emulator::status() const {
+  const Mesh& mesh = simulator_.mesh();
+  const DeviceState& state = simulator_.state();
+  protocol::StatusPayload s;
+  s.pressure_pa = state.pressure_pa;
+  s.cell_jammed = state.cell_jammed;
+  // Every corner of the array, (rows+1) x (cols+1); only inner ones pin.
+  s.node_pinned.assign(static_cast<std::size_t>(mesh.rows() + 1) * (mesh.cols() + 1), 0);
+  for (int a = 1; a < mesh.rows(); ++a)
+    for (int b = 1; b < mesh.cols(); ++b) s.node_pinned[a * (mesh.cols() + 1) + b] = state.pinned(mesh, a, b);
+  return s;
+}
+
+Eigen::MatrixXd Emulator::exact_frame() const {
+  return rasterize_top_view(simulator_.mesh(), simulator_.state().x, config_.camera.grid);
+}
+
+Capture Emulator::capture() {
+  const CameraOptions& cam = config_.camera;
+  Capture c;
+  c.grid = to_capture_grid(cam.grid);
+  c.heights_mm = exact_frame();
+  std::normal_distribution<double> noise(0.0, cam.noise_mm);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (Eigen::Index i = 0; i < c.heights_mm.size(); ++i) {
+    double& h = c.heights_mm.data()[i];
+    if (std::isnan(h)) continue;
+    if (cam.noise_mm > 0.0) h += noise(camera_random_);
+    if (cam.resolution_mm > 0.0) h = std::round(h / cam.resolution_mm) * cam.resolution_mm + 0.0;  // no "-0"
+    if (cam.dropout > 0.0 && uniform(camera_random_) < cam.dropout) h = std::numeric_limits<double>::quiet_NaN();
+  }
+  return c;
+}
+
+}  // namespace hj::device

@@ -1,0 +1,67 @@
+// The emulated array behind the device protocol: a Simulator standing in
+// for membrane and controller, and a depth camera that rasterises the
+// settled surface onto the session grid (src/calib/rasterize.h) with the
+// Gaussian noise, rounding and dropped samples of the shared sessions
+// (data/sessions/*/README.md). It answers one request at a time; the
+// network side is EmulatorServer.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <string>
+
+#include "calib/session.h"
+#include "device/protocol.h"
+#include "sim/simulator.h"
+
+namespace hj::device {
+
+struct CameraOptions {
+  SessionGrid grid;            // where captures sample, mm
+  double noise_mm = 0.0;       // Gaussian sigma added to each height
+  double resolution_mm = 0.0;  // heights rounded to a multiple of this; 0 = exact
+  double dropout = 0.0;        // fraction of samples reported as NaN, [0, 1)
+  std::uint64_t seed = 1;      // of the camera's random generator
+
+  // Throws std::invalid_argument naming the field (and unit) that is wrong.
+  void validate() const;
+};
+
+// The shared sessions' grid for an array: 2 mm samples from (0, 0) covering
+// it (77 x 58 for 3 x 4 cells of 38 mm).
+SessionGrid default_capture_grid(const ArrayGeometry& geometry);
+
+struct EmulatorConfig {
+  ArrayGeometry geometry;
+  SurfaceParameters params;  // params.max_pressure_pa is the device's limit
+  SimulatorOptions simulator;
+  CameraOptions camera;
+};
+
+class Emulator {
+ public:
+  // Builds and settles the simulator at rest. Throws std::invalid_argument
+  // on a bad geometry, parameter, effect or camera option.
+  explicit Emulator(EmulatorConfig config);
+
+  protocol::Hello hello() const;
+  // The reply line to a hello, status, capture, vent or action request:
+  // "ok ID ..." or "err ID CODE message" (out_of_range, unsafe, failed).
+  std::string handle(const protocol::Request& request);
+
+  const Simulator& simulator() const { return simulator_; }
+  // What a capture sees before noise: the surface on the grid, mm.
+  Eigen::MatrixXd exact_frame() const;
+
+ private:
+  std::string act(std::uint64_t id, const Action& action);
+  std::string vent(std::uint64_t id);
+  protocol::StatusPayload status() const;
+  Capture capture();
+
+  EmulatorConfig config_;
+  Simulator simulator_;
+  std::mt19937_64 camera_random_;
+};
+
+}  // namespace hj::device
