@@ -136,7 +136,8 @@ TEST(DeviceProtocol, MalformedRequestsNameWhatIsWrong) {
     } catch (const ProtocolError& e) {
       EXPECT_EQ(e.code(), c.code) << e.what();
       EXPECT_EQ(e.id(), c.id);
-      for (const auto& w : c.words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << w << " not in: " << e.what();
+      for (const auto& w : c.words)
+        EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << w << " not in: " << e.what();
     }
   }
 }
@@ -245,7 +246,8 @@ TEST(DeviceProtocol, GarbageNeverCrashesAParser) {
   std::vector<std::string> inputs;
   const std::vector<std::string> valid = {
       "7 set_pressure 301.25", "8 jam 0 3", "9 fault stall 100", "ok 7 frame 2 1 0 0 2 2 1.5,nan",
-      "err 9 unsafe unsafe pressure", "ok 1 protocol=1 rows=3 cols=4 cell_mm=38 max_pressure_pa=3450 grid=77,58,0,0,2,2",
+      "err 9 unsafe unsafe pressure",
+      "ok 1 protocol=1 rows=3 cols=4 cell_mm=38 max_pressure_pa=3450 grid=77,58,0,0,2,2",
       "ok 2 pressure_pa=0 jammed=000000000000 pinned=00000000000000000000"};
   std::mt19937 random(12345);
   for (const auto& v : valid) {

@@ -1,5 +1,7 @@
 #include "device/asio_device_link.h"
 
+#include <termios.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -82,8 +84,9 @@ struct AsioDeviceLink::Impl {
   bool stopping = false;
   DeviceStatus status;
   std::function<void(bool)> callback;
-  // Bumped on every connection attempt and every drop, so that handlers and
-  // queued writes of an old connection do nothing on a new one.
+  // Bumped (under `mutex`) on every connection attempt and every drop, so
+  // that handlers and queued writes of an old connection do nothing on a
+  // new one.
   std::atomic<unsigned> generation{0};
   std::atomic<std::uint64_t> next_id{1};
 
@@ -114,6 +117,8 @@ struct AsioDeviceLink::Impl {
       if (!ec) serial->set_option(asio::serial_port::parity(asio::serial_port::parity::none), ec);
       if (!ec) serial->set_option(asio::serial_port::stop_bits(asio::serial_port::stop_bits::one), ec);
       if (!ec) serial->set_option(asio::serial_port::flow_control(asio::serial_port::flow_control::none), ec);
+      // Whatever the device sent before (half a reply) is not for us.
+      if (!ec) ::tcflush(serial->native_handle(), TCIOFLUSH);
       if (ec) {
         asio::post(io, [this, gen, m = ec.message()] { fail(gen, "cannot open: " + m); });
         return;
@@ -126,13 +131,17 @@ struct AsioDeviceLink::Impl {
                            [this, gen](boost::system::error_code ec, tcp::resolver::results_type results) {
                              if (gen != generation) return;
                              if (ec) return fail(gen, "cannot resolve: " + ec.message());
-                             asio::async_connect(*socket, results, [this, gen](boost::system::error_code ec, const tcp::endpoint&) {
-                               if (gen != generation) return;
-                               if (ec) return fail(gen, "cannot connect: " + ec.message());
-                               socket->set_option(tcp::no_delay(true), ec);
-                               opened(gen);
-                             });
+                             connect_to(gen, results);
                            });
+  }
+
+  void connect_to(unsigned gen, const tcp::resolver::results_type& addresses) {
+    asio::async_connect(*socket, addresses, [this, gen](boost::system::error_code ec, const tcp::endpoint&) {
+      if (gen != generation) return;
+      if (ec) return fail(gen, "cannot connect: " + ec.message());
+      socket->set_option(tcp::no_delay(true), ec);
+      opened(gen);
+    });
   }
 
   // The stream is open: say hello, read the state, then report "up".
@@ -178,7 +187,9 @@ struct AsioDeviceLink::Impl {
         try {
           lines.feed(
               std::string_view(read_buffer.data(), n), [&](std::string_view line) { received(gen, line); },
-              [&] { throw protocol::ProtocolError(protocol::ErrorCode::kTooLong, 0, "a reply line exceeds the limit"); });
+              [&] {
+                throw protocol::ProtocolError(protocol::ErrorCode::kTooLong, 0, "a reply line exceeds the limit");
+              });
         } catch (const std::exception& e) {
           return fail(gen, std::string("bad reply: ") + e.what());
         }
@@ -226,12 +237,13 @@ struct AsioDeviceLink::Impl {
 
   void write_next(unsigned gen) {
     with_stream([&](auto& stream) {
-      asio::async_write(stream, asio::buffer(write_queue.front()), [this, gen](boost::system::error_code ec, std::size_t) {
+      const auto written = [this, gen](boost::system::error_code ec, std::size_t) {
         if (gen != generation) return;
         if (ec) return fail(gen, "write failed: " + ec.message());
         write_queue.pop_front();
         if (!write_queue.empty()) write_next(gen);
-      });
+      };
+      asio::async_write(stream, asio::buffer(write_queue.front()), written);
     });
   }
 
@@ -281,9 +293,11 @@ struct AsioDeviceLink::Impl {
       std::lock_guard lock(mutex);
       failed.swap(pending);
     }
-    for (auto& [id, p] : failed)
-      p->reply.set_exception(std::make_exception_ptr(DeviceError(
-          Kind::kDisconnected, "device link to " + endpoint.to_string() + " dropped during \"" + p->what + "\": " + reason)));
+    for (auto& [id, p] : failed) {
+      const std::string what =
+          "device link to " + endpoint.to_string() + " dropped during \"" + p->what + "\": " + reason;
+      p->reply.set_exception(std::make_exception_ptr(DeviceError(Kind::kDisconnected, what)));
+    }
   }
 
   // The connection of generation `gen` is gone: fail what waits on it, tell
@@ -334,7 +348,9 @@ struct AsioDeviceLink::Impl {
       gen = generation;
       pending[id] = p;
     }
-    asio::post(io, [this, gen, line = std::to_string(id) + " " + command + "\n"]() mutable { write(gen, std::move(line)); });
+    asio::post(io, [this, gen, line = std::to_string(id) + " " + command + "\n"]() mutable {
+      write(gen, std::move(line));
+    });
     if (reply.wait_for(timeout) != std::future_status::ready) {
       {
         std::lock_guard lock(mutex);

@@ -131,7 +131,8 @@ EmulatorProgramOptions parse_emulator_options(const std::vector<std::string>& ar
         } catch (const std::invalid_argument& e) {
           throw std::invalid_argument(std::string("--effects: ") + e.what());
         }
-        if (baseline) throw std::invalid_argument("--effects: \"" + name + "\" is part of the baseline model, always on");
+        if (baseline)
+          throw std::invalid_argument("--effects: \"" + name + "\" is part of the baseline model, always on");
         effects.push_back(name);
       }
     } else if (a == "--max-pressure-kpa") {
