@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "plan_command.h"
+#include "remote_command.h"
 #include "simulate_command.h"
 
 namespace {
@@ -21,6 +22,7 @@ const std::vector<Command> kCommands = {
     {"simulate", hj::cli::run_simulate},
     {"demo", hj::cli::run_demo},
     {"plan", hj::cli::run_plan},
+    {"remote", hj::cli::run_remote},
 };
 
 constexpr const char* kUsage =
@@ -29,6 +31,8 @@ constexpr const char* kUsage =
     "  simulate SESSION.json --out DIR   replay a session's steps, write predicted frames\n"
     "  demo [--out DIR]                  simulate the paper's Fig. 7 sequence (embedded)\n"
     "  plan GOAL --rows R --cols C --out DIR   plan a goal shape (Algorithm 2)\n"
+    "  remote SUBCOMMAND --server HOST:PORT    a client of hapticjam-server (plan, preview,\n"
+    "                                    submit, watch, cancel, status, stop, resume ...)\n"
     "run 'hapticjam COMMAND --help' for a command's options\n";
 
 }  // namespace
