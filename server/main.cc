@@ -1,15 +1,28 @@
 // hapticjam-server: flags, the device link, a signal wait. Everything else
 // is in hj_server (server.h).
-#include <pthread.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <cstdio>
-#include <iostream>
 #include <thread>
 
 #include "device_link_factory.h"
 #include "json_log.h"
 #include "server.h"
+
+namespace {
+
+// SIGINT / SIGTERM write their number into this pipe; a thread reads it and
+// shuts the server down (a handler may run on any thread, libraries start
+// some before main, so the handler does nothing but write).
+int g_signal_pipe[2] = {-1, -1};
+
+void on_signal(int number) {
+  const char byte = char(number);
+  [[maybe_unused]] const auto written = ::write(g_signal_pipe[1], &byte, 1);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace hj::server;
@@ -26,13 +39,15 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  // SIGINT and SIGTERM go to one thread that shuts the server down; block
-  // them before any other thread exists so none of those receives them.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  if (::pipe(g_signal_pipe) != 0) {
+    std::perror("hapticjam-server: pipe");
+    return 1;
+  }
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
 
   try {
     std::unique_ptr<hj::device::DeviceLink> link;
@@ -41,14 +56,14 @@ int main(int argc, char** argv) {
     std::printf("hapticjam-server listening on port %d\n", server.port());
     std::fflush(stdout);
     std::thread waiter([&] {
-      int received = 0;
-      sigwait(&signals, &received);
-      log_event("signal", {{"signal", received == SIGINT ? "SIGINT" : "SIGTERM"}});
+      char number = 0;
+      while (::read(g_signal_pipe[0], &number, 1) < 0) {
+      }
+      if (number != 0) log_event("signal", {{"signal", number == SIGINT ? "SIGINT" : "SIGTERM"}});
       server.shutdown();
     });
     server.wait();
-    // The waiter returns once a signal came; if the server stopped otherwise, send it one.
-    pthread_kill(waiter.native_handle(), SIGTERM);
+    on_signal(0);  // wakes the waiter if the server stopped by itself
     waiter.join();
     return 0;
   } catch (const std::exception& e) {
