@@ -7,6 +7,7 @@
 
 #include "calib/frame_csv.h"
 #include "hapticjam/v1/device_service.grpc.pb.h"
+#include "progress.h"
 #include "remote_command.h"
 #include "remote_connection.h"
 #include "remote_messages.h"
@@ -77,30 +78,28 @@ void save_captures(const v1::Job& job, const fs::path& dir) {
   }
 }
 
-// Follows the queue until job `id` has finished; its last state.
-v1::JobState follow_job(v1::DeviceService::Stub& stub, const RemoteConnection& connection, std::int64_t id, bool quiet,
-                        bool json) {
+// Follows the queue until job `id` has finished, showing its steps on a
+// progress line; its last state.
+v1::JobState follow_job(v1::DeviceService::Stub& stub, const RemoteConnection& connection, std::int64_t id) {
   auto context = connection.context(0);
   v1::WatchQueueRequest request;
   request.set_recent_finished(16);
   auto reader = stub.WatchQueue(context.get(), request);
+  ProgressLine progress("job " + std::to_string(id));
   v1::QueueState state;
-  std::string last;
   while (reader->Read(&state)) {
     for (const auto& j : state.jobs()) {
       if (j.id() != id) continue;
-      const std::string line = job_line(j);
-      if (!quiet && line != last) {
-        if (json) std::cout << to_json_line(j) << std::endl;
-        else std::cerr << line << "\n";
-      }
-      last = line;
+      const std::string where = j.position() > 0 ? std::to_string(j.position()) + " job(s) ahead" : state_name(j.state());
+      progress.update(j.steps_done(), j.steps_total(), state.paused() ? "queue paused: " + state.pause_reason() : where);
       if (finished(j.state())) {
+        progress.finish();
         context->TryCancel();
         return j.state();
       }
     }
   }
+  progress.finish();
   check(reader->Finish(), "WatchQueue");
   throw std::runtime_error("the queue stream ended before job " + std::to_string(id) + " finished");
 }
@@ -191,7 +190,7 @@ int remote_submit(const SubmitArgs& args) {
   else std::printf("submitted %s\n", job_line(response.job()).c_str()), std::fflush(stdout);
   if (!args.wait) return 0;
 
-  const v1::JobState end = follow_job(*stub, connection, response.job().id(), false, false);
+  const v1::JobState end = follow_job(*stub, connection, response.job().id());
   v1::GetJobRequest get;
   get.set_id(response.job().id());
   v1::Job job;

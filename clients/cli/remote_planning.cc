@@ -101,6 +101,7 @@ int remote_plan(const RemotePlanArgs& args) {
       have_result = true;
     }
   }
+  if (have_result) progress.update(100, 100, "done");
   progress.finish();
   check(reader->Finish(), "Plan");
   if (!have_result) throw std::runtime_error("the server ended the plan stream without a result");
