@@ -93,7 +93,10 @@ void DeviceQueue::run() {
   std::unique_lock lock(mutex_);
   while (!stopping_) {
     if (connected_ && need_vent_) {
-      if (!vent_now(lock)) wake_.wait_for(lock, std::chrono::milliseconds(500), [&] { return stopping_; });
+      const std::uint64_t seen = version_;
+      // Failed: retry after a pause, or at once when the link comes back.
+      if (!vent_now(lock))
+        wake_.wait_for(lock, std::chrono::milliseconds(500), [&] { return stopping_ || version_ > seen + 1; });
       continue;
     }
     const bool can_run = connected_ && !store_.paused() && !emergency_stopped_;

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <thread>
 
-#include "device_link_factory.h"
+#include "device/make_device_link.h"
 #include "json_log.h"
 #include "server.h"
 
@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
 
   try {
     std::unique_ptr<hj::device::DeviceLink> link;
-    if (!options.device.empty()) link = open_device_link(options.device);
+    if (!options.device.empty()) link = hj::device::make_device_link(options.device);
     HapticServer server(options, std::move(link));
     std::printf("hapticjam-server listening on port %d\n", server.port());
     std::fflush(stdout);

@@ -230,6 +230,11 @@ TEST(DeviceEmulatorProgram, ServesTheLinkDropsOnCueAndStopsOnSigterm) {
   }
   ASSERT_TRUE(events.reach(3));
   EXPECT_EQ(link.query_status(kLong).pressure_pa, 301.0);
+  // Told to stall over the protocol: a command times out, pings go on.
+  EXPECT_EQ(link.send_raw("fault stall 400", kLong), "");
+  expect_error<DeviceError>([&] { link.capture(50ms); }, {"capture", "no reply within 50 ms"});
+  link.ping(kLong);
+  expect_error<DeviceError>([&] { link.send_raw("fault explode", kLong); }, {"malformed", "unknown fault"});
   link.stop();
   EXPECT_EQ(process.terminate(), 0);
 }

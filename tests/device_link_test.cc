@@ -175,6 +175,27 @@ TEST_F(DeviceLinkTest, AStalledDeviceTimesOutTheCommandAndTheLinkRecovers) {
   EXPECT_EQ(link->query_status(kLong).pressure_pa, 200.0);
 }
 
+// Replies that race their command's timeout: each command either returns
+// or times out, and the late replies confuse no later command.
+TEST_F(DeviceLinkTest, RepliesRacingTheirTimeoutAreEitherTakenOrDropped) {
+  EmulatedDevice device;
+  connect(device);
+  int answered = 0, timed_out = 0;
+  for (int i = 0; i < 300; ++i) {
+    try {
+      link->ping(std::chrono::milliseconds(i % 2));
+      ++answered;
+    } catch (const DeviceError& e) {
+      ASSERT_EQ(e.kind(), DeviceError::Kind::kTimeout) << e.what();
+      ++timed_out;
+    }
+  }
+  EXPECT_EQ(answered + timed_out, 300);
+  link->execute(Action::set_pressure(700.0), kLong);
+  EXPECT_EQ(link->query_status(kLong).pressure_pa, 700.0);
+  EXPECT_TRUE(link->connected());
+}
+
 TEST_F(DeviceLinkTest, ADropDuringACommandFailsItThenTheLinkReconnects) {
   EmulatedDevice device;
   connect(device);

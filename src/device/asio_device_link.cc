@@ -30,10 +30,17 @@ using Kind = DeviceError::Kind;
 
 namespace {
 
-// A command a caller waits for; the io thread fulfils or fails it.
+// How a command ended, as the io thread hands it to the waiting caller
+// (who builds any exception in its own thread).
+struct Outcome {
+  protocol::Reply reply;
+  std::string dropped;  // non-empty: the link dropped, and why
+};
+
+// A command a caller waits for; the io thread fulfils it.
 struct Pending {
   std::string what;  // the command as sent, for messages
-  std::promise<protocol::Reply> reply;
+  std::promise<Outcome> outcome;
 };
 
 long long ms(std::chrono::milliseconds d) { return static_cast<long long>(d.count()); }
@@ -73,7 +80,7 @@ struct AsioDeviceLink::Impl {
   std::array<char, 64 * 1024> read_buffer{};
   std::deque<std::string> write_queue;
   std::map<std::uint64_t, std::function<void(const protocol::Reply&)>> internal;  // hello, status, ping
-  Clock::time_point last_line;
+  Clock::time_point last_data;  // bytes of a long reply count as life too
   bool ping_outstanding = false;
   std::chrono::milliseconds backoff;
 
@@ -146,7 +153,7 @@ struct AsioDeviceLink::Impl {
 
   // The stream is open: say hello, read the state, then report "up".
   void opened(unsigned gen) {
-    last_line = Clock::now();
+    last_data = Clock::now();
     read(gen);
     send_internal(gen, "hello", [this, gen](const protocol::Reply& r) {
       if (!r.ok) return fail(gen, "hello refused: " + r.code + " " + r.text);
@@ -184,6 +191,7 @@ struct AsioDeviceLink::Impl {
       stream.async_read_some(asio::buffer(read_buffer), [this, gen](boost::system::error_code ec, std::size_t n) {
         if (gen != generation) return;
         if (ec) return fail(gen, ec == asio::error::eof ? "the device closed the connection" : ec.message());
+        last_data = Clock::now();
         try {
           lines.feed(
               std::string_view(read_buffer.data(), n), [&](std::string_view line) { received(gen, line); },
@@ -199,9 +207,7 @@ struct AsioDeviceLink::Impl {
   }
 
   void received(unsigned gen, std::string_view line) {
-    if (gen != generation) return;
-    last_line = Clock::now();
-    if (line.empty()) return;
+    if (gen != generation || line.empty()) return;
     const protocol::Reply reply = protocol::parse_reply(line);
     if (const auto it = internal.find(reply.id); it != internal.end()) {
       const auto handler = std::move(it->second);
@@ -220,7 +226,7 @@ struct AsioDeviceLink::Impl {
       }
     }
     // A reply whose caller has timed out is dropped.
-    if (waiting) waiting->reply.set_value(reply);
+    if (waiting) waiting->outcome.set_value({reply, ""});
   }
 
   void send_internal(unsigned gen, const std::string& command, std::function<void(const protocol::Reply&)> handler) {
@@ -251,8 +257,9 @@ struct AsioDeviceLink::Impl {
     heartbeat_timer.expires_after(options.heartbeat_interval);
     heartbeat_timer.async_wait([this, gen](boost::system::error_code ec) {
       if (ec || gen != generation) return;
-      if (Clock::now() - last_line > options.heartbeat_timeout)
-        return fail(gen, "no reply to the heartbeat for " + std::to_string(ms(options.heartbeat_timeout)) + " ms");
+      if (Clock::now() - last_data > options.heartbeat_timeout)
+        return fail(gen, "nothing received for " + std::to_string(ms(options.heartbeat_timeout)) +
+                             " ms (heartbeat)");
       if (!ping_outstanding) {
         ping_outstanding = true;
         send_internal(gen, "ping", [this](const protocol::Reply&) { ping_outstanding = false; });
@@ -296,7 +303,7 @@ struct AsioDeviceLink::Impl {
     for (auto& [id, p] : failed) {
       const std::string what =
           "device link to " + endpoint.to_string() + " dropped during \"" + p->what + "\": " + reason;
-      p->reply.set_exception(std::make_exception_ptr(DeviceError(Kind::kDisconnected, what)));
+      p->outcome.set_value({{}, what});
     }
   }
 
@@ -337,7 +344,7 @@ struct AsioDeviceLink::Impl {
     const std::uint64_t id = next_id++;
     auto p = std::make_shared<Pending>();
     p->what = command;
-    std::future<protocol::Reply> reply = p->reply.get_future();
+    std::future<Outcome> outcome = p->outcome.get_future();
     unsigned gen = 0;
     {
       std::lock_guard lock(mutex);
@@ -351,20 +358,23 @@ struct AsioDeviceLink::Impl {
     asio::post(io, [this, gen, line = std::to_string(id) + " " + command + "\n"]() mutable {
       write(gen, std::move(line));
     });
-    if (reply.wait_for(timeout) != std::future_status::ready) {
-      {
-        std::lock_guard lock(mutex);
-        // Fulfilled or failed just now by the io thread: take that instead.
-        if (pending.erase(id) == 0) return finish(command, reply.get());
-        status.last_error = "\"" + command + "\" timed out";
-      }
+    bool timed_out = false;
+    if (outcome.wait_for(timeout) != std::future_status::ready) {
+      std::lock_guard lock(mutex);
+      // Unless the io thread took it just now (then its outcome follows),
+      // give up on it; a late reply will find no one waiting.
+      timed_out = pending.erase(id) == 1;
+      if (timed_out) status.last_error = "\"" + command + "\" timed out";
+    }
+    if (timed_out)
       throw DeviceError(Kind::kTimeout, "device command \"" + command + "\" got no reply within " +
                                             std::to_string(ms(timeout)) + " ms");
-    }
-    return finish(command, reply.get());
+    return finish(command, outcome.get());
   }
 
-  protocol::Reply finish(const std::string& command, protocol::Reply reply) {
+  protocol::Reply finish(const std::string& command, Outcome outcome) {
+    if (!outcome.dropped.empty()) throw DeviceError(Kind::kDisconnected, outcome.dropped);
+    const protocol::Reply& reply = outcome.reply;
     if (reply.ok) return reply;
     const std::string what = "device refused \"" + command + "\": " + reply.code + ": " + reply.text;
     {

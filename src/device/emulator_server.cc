@@ -120,7 +120,12 @@ struct EmulatorServer::Impl {
     std::weak_ptr<Connection> weak = c;
     std::lock_guard lock(mutex);
     jobs.push_back([this, weak, r] {
-      std::string reply = emulator.handle(r);
+      std::string reply;
+      try {
+        reply = emulator.handle(r);
+      } catch (const std::exception& e) {  // a failure of the device, not of the server
+        reply = protocol::format_err(r.id, protocol::ErrorCode::kFailed, e.what());
+      }
       ++answered;
       asio::post(io, [this, weak, reply = std::move(reply)] {
         if (const auto c = weak.lock()) write(c, reply);

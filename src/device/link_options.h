@@ -11,10 +11,11 @@ namespace hj::device {
 struct LinkOptions {
   // Opening the connection plus the "hello" exchange.
   std::chrono::milliseconds connect_timeout{2000};
-  // A "ping" this often while connected; no reply line at all for
-  // heartbeat_timeout means the link is down.
-  std::chrono::milliseconds heartbeat_interval{500};
-  std::chrono::milliseconds heartbeat_timeout{2000};
+  // A "ping" this often while connected; nothing at all received for
+  // heartbeat_timeout means the link is down (a silent drop is found
+  // within heartbeat_timeout + heartbeat_interval; a closed one at once).
+  std::chrono::milliseconds heartbeat_interval{200};
+  std::chrono::milliseconds heartbeat_timeout{800};
   // Reconnect delays: initial, times backoff_factor after each failed
   // attempt, at most backoff_max; back to initial after a success.
   std::chrono::milliseconds backoff_initial{100};
