@@ -144,8 +144,8 @@ inline CliResult run_cli(const std::vector<std::string>& args, const std::filesy
   const std::string tag = std::to_string(++counter);
   const auto out = dir / ("cli" + tag + ".out"), err = dir / ("cli" + tag + ".err");
   std::string command = shell_quote(HJ_CLI_PATH);
-  for (const auto& a : args) command += " " + shell_quote(a);
-  command += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+  for (const auto& a : args) command.append(" ").append(shell_quote(a));
+  command.append(" >").append(shell_quote(out.string())).append(" 2>").append(shell_quote(err.string()));
   const int status = std::system(command.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(out), read_file(err)};
 }
