@@ -221,6 +221,15 @@ TEST(ServerPlanning, AGoalOverTheMessageLimitIsRefusedNamingTheLimit) {
                  {"larger than max"});
 }
 
+TEST(ServerPlanning, AGoalWithTooManyPixelsIsRefusedNamingTheLimit) {
+  ScratchDir dir;
+  server::ServerOptions o = options(1, 4, dir.path / "q.db");
+  o.limits.max_goal_pixels = 100;
+  TestServer s(o, false);
+  expect_refused(s, preview_request(2, 2, bump_csv(16, 20)), StatusCode::INVALID_ARGUMENT,
+                 {"bump.csv", "more than 100 values"});
+}
+
 TEST(ServerPlanning, MapsAreCroppedToTheRequestedRegion) {
   ScratchDir dir;
   server::ServerOptions o = options(1, 4, dir.path / "q.db");
