@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "plan_command.h"
+#include "remote_command.h"
 #include "simulate_command.h"
 #include "synth_command.h"
 
@@ -23,6 +24,7 @@ const std::vector<Command> kCommands = {
     {"demo", hj::cli::run_demo},
     {"plan", hj::cli::run_plan},
     {"synth", hj::cli::run_synth},
+    {"remote", hj::cli::run_remote},
 };
 
 constexpr const char* kUsage =
@@ -32,6 +34,8 @@ constexpr const char* kUsage =
     "  demo [--out DIR]                  simulate the paper's Fig. 7 sequence (embedded)\n"
     "  plan GOAL --rows R --cols C --out DIR   plan a goal shape (Algorithm 2)\n"
     "  synth DATASET --out DIR           a synthetic dataset: DATASET's sessions replayed with a model + noise\n"
+    "  remote SUBCOMMAND --server HOST:PORT    a client of hapticjam-server (plan, preview,\n"
+    "                                    submit, watch, cancel, status, stop, resume ...)\n"
     "run 'hapticjam COMMAND --help' for a command's options\n";
 
 }  // namespace

@@ -1,0 +1,190 @@
+"""Client: one channel to a hapticjam-server, the bearer token on every call,
+and the PlanningService and DeviceService calls as methods. A refused call
+raises ClientError carrying the gRPC status code and the server's message."""
+
+import json
+import os
+
+import grpc
+from hapticjam.v1 import (array_pb2, device_service_pb2, device_service_pb2_grpc, goal_pb2, plan_pb2,
+                          planning_service_pb2, planning_service_pb2_grpc)
+
+# Goals (meshes, DEMs) may exceed gRPC's 4 MiB default; the server takes up to 64 MiB.
+MAX_MESSAGE_BYTES = 64 << 20
+
+JOB_STATES = {v: k[len("JOB_STATE_"):].lower() for k, v in device_service_pb2.JobState.items()}
+FINISHED = {device_service_pb2.JOB_STATE_DONE, device_service_pb2.JOB_STATE_FAILED,
+            device_service_pb2.JOB_STATE_CANCELLED, device_service_pb2.JOB_STATE_INTERRUPTED}
+
+
+class ClientError(Exception):
+    """A call the server (or gRPC) refused: .code is a grpc.StatusCode, .details the message."""
+
+    def __init__(self, call, error):
+        self.call = call
+        self.code = error.code()
+        self.details = error.details()
+        super().__init__(f"{call}: {self.code.name}: {self.details}")
+
+
+def file_goal(path, region=None, max_height_mm=0.0, up_axis="", hue=False, view_resolution=0):
+    """A Goal from a file's bytes (the format follows its extension).
+    region: (x0, y0, x1, y1), fractions of the image, or pixels if any exceeds 1."""
+    with open(path, "rb") as f:
+        content = f.read()
+    goal = goal_pb2.Goal(file=goal_pb2.GoalFile(content=content, file_name=os.path.basename(path)))
+    return _finish_goal(goal, region, max_height_mm, up_axis, hue, view_resolution)
+
+
+def map_goal(name, region=None, max_height_mm=0.0):
+    """A Goal naming a map the server was started with (--map NAME=FILE)."""
+    return _finish_goal(goal_pb2.Goal(map_name=name), region, max_height_mm, "", False, 0)
+
+
+def _finish_goal(goal, region, max_height_mm, up_axis, hue, view_resolution):
+    if region is not None:
+        x0, y0, x1, y1 = region
+        goal.region.CopyFrom(goal_pb2.Region(x0=x0, y0=y0, x1=x1, y1=y1, pixels=any(v > 1 for v in region)))
+    goal.options.CopyFrom(goal_pb2.GoalOptions(
+        max_height_mm=max_height_mm, up_axis=up_axis, view_resolution=view_resolution,
+        encoding=goal_pb2.HEIGHT_ENCODING_HUE if hue else goal_pb2.HEIGHT_ENCODING_UNSPECIFIED))
+    return goal
+
+
+def array_spec(rows, cols, segments=0, cell_size_mm=0.0):
+    return array_pb2.ArraySpec(rows=rows, cols=cols, segments=segments, cell_size_mm=cell_size_mm)
+
+
+def plan_from_steps(steps, planner=""):
+    """A Plan from session-format steps (the "steps" of a plan.json), e.g.
+    [{"op": "set_pressure", "kpa": 0.3}, {"op": "jam", "cell": [0, 1]}, {"op": "capture"}]."""
+    plan = plan_pb2.Plan(planner=planner)
+    for i, s in enumerate(steps):
+        op = s.get("op")
+        step = plan.steps.add(label=s.get("label", ""))
+        if op == "set_pressure":
+            step.set_pressure.kpa = float(s["kpa"])
+        elif op in ("jam", "unjam"):
+            getattr(step, op).CopyFrom(array_pb2.CellIndex(row=s["cell"][0], col=s["cell"][1]))
+        elif op in ("pin", "unpin"):
+            getattr(step, op).CopyFrom(array_pb2.NodeIndex(a=s["node"][0], b=s["node"][1]))
+        elif op == "capture":
+            step.capture.SetInParent()
+        else:
+            raise ValueError(f"step {i}: unknown op {op!r}")
+    return plan
+
+
+def plan_from_file(path):
+    """The Plan in a plan.json (what `hapticjam plan` writes) or a session.json."""
+    with open(path) as f:
+        doc = json.load(f)
+    return plan_from_steps(doc["steps"] if isinstance(doc, dict) else doc,
+                           doc.get("planner", "") if isinstance(doc, dict) else "")
+
+
+class Client:
+    """client = Client("127.0.0.1:50051", token="..."); client.preview(...)."""
+
+    def __init__(self, server, token=None, root_certificates=None):
+        options = [("grpc.max_receive_message_length", MAX_MESSAGE_BYTES),
+                   ("grpc.max_send_message_length", MAX_MESSAGE_BYTES)]
+        if root_certificates is None:
+            self.channel = grpc.insecure_channel(server, options=options)
+        else:
+            self.channel = grpc.secure_channel(server, grpc.ssl_channel_credentials(root_certificates), options)
+        self.server = server
+        self.metadata = [("authorization", "Bearer " + token)] if token else []
+        self.planning = planning_service_pb2_grpc.PlanningServiceStub(self.channel)
+        self.device = device_service_pb2_grpc.DeviceServiceStub(self.channel)
+
+    def close(self):
+        self.channel.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _call(self, name, method, request, timeout):
+        try:
+            return method(request, timeout=timeout, metadata=self.metadata)
+        except grpc.RpcError as e:
+            raise ClientError(name, e) from None
+
+    # -- planning --
+
+    def planners(self, timeout=30):
+        return self._call("ListPlanners", self.planning.ListPlanners, planning_service_pb2.ListPlannersRequest(),
+                          timeout)
+
+    def preview(self, goal, rows, cols, segments=0, planner="", timeout=120):
+        request = planning_service_pb2.PreviewRequest(array=array_spec(rows, cols, segments), goal=goal,
+                                                      planner=planner)
+        return self._call("Preview", self.planning.Preview, request, timeout)
+
+    def plan(self, goal, rows, cols, segments=0, planner="", on_event=None, omit_snapshots=False, timeout=None):
+        """Streams a plan; on_event(PlanEvent) sees every progress and snapshot.
+        Returns (PlanResult, number of snapshots)."""
+        request = planning_service_pb2.PlanRequest(array=array_spec(rows, cols, segments), goal=goal,
+                                                   planner=planner, omit_snapshots=omit_snapshots)
+        result, snapshots = None, 0
+        try:
+            for event in self.planning.Plan(request, timeout=timeout, metadata=self.metadata):
+                if on_event:
+                    on_event(event)
+                kind = event.WhichOneof("event")
+                if kind == "snapshot":
+                    snapshots += 1
+                elif kind == "result":
+                    result = event.result
+        except grpc.RpcError as e:
+            raise ClientError("Plan", e) from None
+        if result is None:
+            raise RuntimeError("the server ended the plan stream without a result")
+        return result, snapshots
+
+    # -- device --
+
+    def submit(self, plan, name="", timeout=30):
+        request = device_service_pb2.SubmitJobRequest(plan=plan, name=name)
+        return self._call("SubmitJob", self.device.SubmitJob, request, timeout).job
+
+    def cancel(self, job_id, timeout=30):
+        return self._call("CancelJob", self.device.CancelJob, device_service_pb2.CancelJobRequest(id=job_id),
+                          timeout).job
+
+    def job(self, job_id, timeout=30):
+        return self._call("GetJob", self.device.GetJob, device_service_pb2.GetJobRequest(id=job_id), timeout)
+
+    def status(self, timeout=30):
+        return self._call("GetDeviceStatus", self.device.GetDeviceStatus,
+                          device_service_pb2.GetDeviceStatusRequest(), timeout)
+
+    def stop(self, reason="", timeout=30):
+        return self._call("EmergencyStop", self.device.EmergencyStop,
+                          device_service_pb2.EmergencyStopRequest(reason=reason), timeout)
+
+    def resume(self, timeout=30):
+        return self._call("ResumeQueue", self.device.ResumeQueue, device_service_pb2.ResumeQueueRequest(), timeout)
+
+    def watch(self, recent_finished=0, timeout=None):
+        """Yields QueueState now and at every change (a generator; cancel by leaving it)."""
+        stream = self.device.WatchQueue(device_service_pb2.WatchQueueRequest(recent_finished=recent_finished),
+                                        timeout=timeout, metadata=self.metadata)
+        try:
+            yield from stream
+        except grpc.RpcError as e:
+            if e.code() != grpc.StatusCode.CANCELLED:
+                raise ClientError("WatchQueue", e) from None
+        finally:
+            stream.cancel()
+
+    def wait_for_job(self, job_id, timeout=60):
+        """Follows the queue until job_id has finished; returns that Job (with its captures)."""
+        for state in self.watch(recent_finished=32, timeout=timeout):
+            for j in state.jobs:
+                if j.id == job_id and j.state in FINISHED:
+                    return self.job(job_id)
+        raise RuntimeError(f"the queue stream ended before job {job_id} finished")
