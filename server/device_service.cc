@@ -74,7 +74,7 @@ grpc::Status DeviceServiceImpl::ResumeQueue(grpc::ServerContext* context, const 
                                             v1::QueueState* response) {
   RequestContext rc(context, "ResumeQueue");
   return rc.finish([&] {
-    const Caller& caller = rc.authorize(auth_, Role::kAdmin, "ResumeQueue");
+    const Caller& caller = rc.authorize(auth_, Role::kOperator, "ResumeQueue");
     *response = queue_.resume(caller);
   });
 }

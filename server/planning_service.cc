@@ -153,9 +153,13 @@ grpc::Status PlanningServiceImpl::plan_or_cached(grpc::ServerContext* context, c
       if (!written) work->stop = true;
     }
     if (work->done) break;
-    if (context->IsCancelled() || Clock::now() > work->deadline) {
+    if (Clock::now() > work->deadline) {
       work->stop = true;
-      return {grpc::StatusCode::CANCELLED, "the caller cancelled or its deadline passed"};
+      return {grpc::StatusCode::DEADLINE_EXCEEDED, "the caller's deadline passed before the plan was done"};
+    }
+    if (context->IsCancelled()) {
+      work->stop = true;
+      return {grpc::StatusCode::CANCELLED, "the caller cancelled"};
     }
   }
   if (!work->done->ok()) return *work->done;

@@ -23,8 +23,10 @@ WorkPool::~WorkPool() {
 
 bool WorkPool::try_submit(std::function<void()> task) {
   {
-    std::lock_guard lock(mutex_);
-    if (stopping_ || int(tasks_.size()) >= queue_size_ + idle_) return false;
+    std::unique_lock lock(mutex_);
+    const bool room = idle_changed_.wait_for(
+        lock, kFullGrace, [&] { return stopping_ || int(tasks_.size()) < queue_size_ + idle_; });
+    if (stopping_ || !room) return false;
     tasks_.push_back(std::move(task));
   }
   wake_.notify_one();
@@ -42,6 +44,7 @@ void WorkPool::run() {
     {
       std::unique_lock lock(mutex_);
       ++idle_;
+      idle_changed_.notify_all();
       wake_.wait(lock, [&] { return stopping_ || !tasks_.empty(); });
       --idle_;
       if (stopping_) return;
