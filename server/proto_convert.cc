@@ -120,6 +120,13 @@ void snapshot_to_proto(const Mesh& mesh, const DeviceState& state, int steps_app
   h->Reserve(int(heights_mm.size()));
   for (int i = 0; i < heights_mm.rows(); ++i)
     for (int j = 0; j < heights_mm.cols(); ++j) h->Add(heights_mm(i, j));
+  out->mutable_x_mm()->Reserve(int(heights_mm.size()));
+  out->mutable_y_mm()->Reserve(int(heights_mm.size()));
+  for (int i = 0; i < heights_mm.rows(); ++i)
+    for (int j = 0; j < heights_mm.cols(); ++j) {
+      out->add_x_mm(state.x(0, mesh.index(i, j)) * 1000.0);
+      out->add_y_mm(state.x(1, mesh.index(i, j)) * 1000.0);
+    }
   out->set_pressure_pa(state.pressure_pa);
   for (int r = 0; r < mesh.rows(); ++r)
     for (int c = 0; c < mesh.cols(); ++c)

@@ -80,6 +80,32 @@ TEST(RemoteMessages, ACaptureOfThePredictedPlaneDiffersByItsOffset) {
   EXPECT_EQ(compare_capture(plane_frame(39, 58, 1.0, 0.1, -0.05), predicted, 9.5).points, 13 * 9);  // x <= 76 mm
 }
 
+TEST(RemoteMessages, ACaptureIsComparedWhereEachPointSits) {
+  // Points pulled inwards towards the centre (as a dome pulls them), on the
+  // plane z = 1 + 0.1 x - 0.05 y at their displaced positions.
+  Eigen::MatrixXd predicted(13, 17), x(13, 17), y(13, 17);
+  for (int i = 0; i < 13; ++i)
+    for (int j = 0; j < 17; ++j) {
+      x(i, j) = 76.0 + 0.9 * (9.5 * j - 76.0);
+      y(i, j) = 57.0 + 0.9 * (9.5 * i - 57.0);
+      predicted(i, j) = 1.0 + 0.1 * x(i, j) - 0.05 * y(i, j);
+    }
+  const v1::CaptureFrame frame = plane_frame(77, 58, 1.0, 0.1, -0.05);
+  EXPECT_NEAR(compare_capture(frame, predicted, 9.5, &x, &y).rms_mm, 0.0, 1e-9);
+  // At the rest positions the same prediction looks wrong by the pull.
+  EXPECT_GT(compare_capture(frame, predicted, 9.5).rms_mm, 0.3);  // 0.5 mm here
+
+  v1::SurfaceSnapshot s;
+  s.set_point_rows(1), s.set_point_cols(2);
+  s.add_heights_mm(1), s.add_heights_mm(2);
+  Eigen::MatrixXd sx, sy;
+  EXPECT_FALSE(snapshot_positions(s, sx, sy));  // an older server: no positions
+  s.add_x_mm(10), s.add_x_mm(20), s.add_y_mm(-1), s.add_y_mm(-2);
+  ASSERT_TRUE(snapshot_positions(s, sx, sy));
+  EXPECT_EQ(sx(0, 1), 20.0);
+  EXPECT_EQ(sy(0, 1), -2.0);
+}
+
 TEST(RemoteMessages, SurfacesOfTheWrongSizeAreErrors) {
   v1::SurfaceSnapshot s;
   s.set_point_rows(2), s.set_point_cols(3);

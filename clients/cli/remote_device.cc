@@ -171,8 +171,19 @@ void print_difference(const std::string& plan_file, const v1::CaptureFrame& fram
   const int rows = array.value("rows", 0), cols = array.value("cols", 0), segments = array.value("segments", 0);
   const double cell_mm = array.value("cell_size_mm", 38.0);
   if (rows < 1 || cols < 1 || segments < 1) return;
-  const Eigen::MatrixXd predicted = read_frame_csv(predicted_file, rows * segments + 1, cols * segments + 1);
-  const SurfaceDifference d = compare_capture(frame, predicted, cell_mm / segments);
+  const int point_rows = rows * segments + 1, point_cols = cols * segments + 1;
+  const Eigen::MatrixXd predicted = read_frame_csv(predicted_file, point_rows, point_cols);
+  // The predicted in-plane positions, when the plan came with them.
+  const fs::path x_file = fs::path(plan_file).parent_path() / "predicted_x.csv";
+  const fs::path y_file = fs::path(plan_file).parent_path() / "predicted_y.csv";
+  Eigen::MatrixXd x_mm, y_mm;
+  const bool positioned = fs::exists(x_file) && fs::exists(y_file);
+  if (positioned) {
+    x_mm = read_frame_csv(x_file, point_rows, point_cols);
+    y_mm = read_frame_csv(y_file, point_rows, point_cols);
+  }
+  const SurfaceDifference d = compare_capture(frame, predicted, cell_mm / segments, positioned ? &x_mm : nullptr,
+                                              positioned ? &y_mm : nullptr);
   std::printf("captured - predicted over %d mesh points: rms %.2f mm, max |d| %.2f mm, mean %+.2f mm\n", d.points,
               d.rms_mm, d.max_abs_mm, d.mean_mm);
 }

@@ -90,17 +90,34 @@ Eigen::MatrixXd frame_heights(const v1::CaptureFrame& frame) {
   return out;
 }
 
+bool snapshot_positions(const v1::SurfaceSnapshot& snapshot, Eigen::MatrixXd& x_mm, Eigen::MatrixXd& y_mm) {
+  const int n = snapshot.heights_mm_size();
+  if (n == 0 || snapshot.x_mm_size() != n || snapshot.y_mm_size() != n) return false;
+  x_mm.resize(snapshot.point_rows(), snapshot.point_cols());
+  y_mm.resize(snapshot.point_rows(), snapshot.point_cols());
+  for (int i = 0; i < x_mm.rows(); ++i)
+    for (int j = 0; j < x_mm.cols(); ++j) {
+      x_mm(i, j) = snapshot.x_mm(i * x_mm.cols() + j);
+      y_mm(i, j) = snapshot.y_mm(i * x_mm.cols() + j);
+    }
+  return true;
+}
+
 SurfaceDifference compare_capture(const v1::CaptureFrame& frame, const Eigen::MatrixXd& predicted_mm,
-                                  double point_spacing_mm) {
+                                  double point_spacing_mm, const Eigen::MatrixXd* x_mm, const Eigen::MatrixXd* y_mm) {
+  const bool positioned = x_mm && y_mm && x_mm->rows() == predicted_mm.rows() && x_mm->cols() == predicted_mm.cols() &&
+                          y_mm->rows() == predicted_mm.rows() && y_mm->cols() == predicted_mm.cols();
   const Eigen::MatrixXd z = frame_heights(frame);
   const auto& g = frame.grid();
   SurfaceDifference d;
   double sum = 0.0, sum_sq = 0.0;
   for (int i = 0; i < predicted_mm.rows(); ++i)
     for (int j = 0; j < predicted_mm.cols(); ++j) {
-      // Mesh point (i, j) sits at x = j s, y = i s; in frame sample units:
-      const double fx = (j * point_spacing_mm - g.x0_mm()) / g.dx_mm();
-      const double fy = (i * point_spacing_mm - g.y0_mm()) / g.dy_mm();
+      // Where mesh point (i, j) sits, in frame sample units:
+      const double px = positioned ? (*x_mm)(i, j) : j * point_spacing_mm;
+      const double py = positioned ? (*y_mm)(i, j) : i * point_spacing_mm;
+      const double fx = (px - g.x0_mm()) / g.dx_mm();
+      const double fy = (py - g.y0_mm()) / g.dy_mm();
       if (fx < 0 || fy < 0 || fx > g.nx() - 1 || fy > g.ny() - 1) continue;
       const int x0 = std::min(int(fx), std::max(g.nx() - 2, 0)), y0 = std::min(int(fy), std::max(g.ny() - 2, 0));
       const int x1 = std::min(x0 + 1, g.nx() - 1), y1 = std::min(y0 + 1, g.ny() - 1);

@@ -23,12 +23,18 @@ hapticjam::v1::Plan plan_from_steps_json(const nlohmann::json& doc, const std::s
 // (point_rows x point_cols) heights in mm, row i along +y.
 // @throws std::runtime_error if the sizes disagree.
 Eigen::MatrixXd snapshot_heights(const hapticjam::v1::SurfaceSnapshot& snapshot);
+// The in-plane positions (mm) of the snapshot's points, same shape as its
+// heights; false if the server sent none.
+bool snapshot_positions(const hapticjam::v1::SurfaceSnapshot& snapshot, Eigen::MatrixXd& x_mm, Eigen::MatrixXd& y_mm);
 // (ny x nx) heights in mm, NaN where the camera saw nothing.
 Eigen::MatrixXd frame_heights(const hapticjam::v1::CaptureFrame& frame);
 
 // A captured frame against a predicted surface at the mesh points it covers
 // (bilinear from the frame's four samples around each point; points with a
-// missing sample around them are skipped).
+// missing sample around them are skipped). Each point is looked up where it
+// sits: at (x_mm, y_mm) when given (the predicted in-plane positions), else
+// at its rest position (j s, i s), which is wrong by the in-plane pull of a
+// domed membrane.
 struct SurfaceDifference {
   int points = 0;        // mesh points compared
   double rms_mm = 0.0;   // root mean square of captured - predicted
@@ -36,7 +42,8 @@ struct SurfaceDifference {
   double mean_mm = 0.0;  // mean of captured - predicted
 };
 SurfaceDifference compare_capture(const hapticjam::v1::CaptureFrame& frame, const Eigen::MatrixXd& predicted_mm,
-                                  double point_spacing_mm);
+                                  double point_spacing_mm, const Eigen::MatrixXd* x_mm = nullptr,
+                                  const Eigen::MatrixXd* y_mm = nullptr);
 
 // One line of JSON with the proto field names, defaults included.
 std::string to_json_line(const google::protobuf::Message& message);

@@ -36,7 +36,8 @@ std::string correlation_text(bool has, double value, const std::string& why) {
 constexpr const char* kPlanUsage =
     "usage: hapticjam remote plan GOAL|--map NAME --rows R --cols C --out DIR [options]\n"
     "Plans on the server, showing its progress live, and writes what local 'hapticjam plan'\n"
-    "writes: DIR/plan.json (steps, correlation, Laplace mean), DIR/predicted.csv,\n"
+    "writes: DIR/plan.json (steps, correlation, Laplace mean), DIR/predicted.csv\n"
+    "(heights) with DIR/predicted_x.csv and predicted_y.csv (in-plane positions),\n"
     "DIR/goal.csv, DIR/compare.png; with --snapshots also DIR/snapshots/NNN.csv, every\n"
     "surface snapshot the server streamed (mm per mesh point, row i along +y).\n"
     "  --out DIR             where to write\n"
@@ -114,6 +115,11 @@ int remote_plan(const RemotePlanArgs& args) {
   for (int i = 0; i < goal.rows(); ++i)
     for (int j = 0; j < goal.cols(); ++j) goal(i, j) = result.goal_heights_mm(i * goal.cols() + j);
   write_frame_csv(out / "predicted.csv", predicted);
+  Eigen::MatrixXd x_mm, y_mm;
+  if (snapshot_positions(result.predicted(), x_mm, y_mm)) {
+    write_frame_csv(out / "predicted_x.csv", x_mm);
+    write_frame_csv(out / "predicted_y.csv", y_mm);
+  }
   write_frame_csv(out / "goal.csv", goal);
   // The mesh the server used follows from the surface it sent: R p + 1 points along y.
   const int segments = (predicted.rows() - 1) / args.goal.rows;
