@@ -79,5 +79,33 @@ TEST(Algorithm2, CancellationStopsThePlan) {
                PlanCancelled);
 }
 
+TEST(Algorithm2, CancellationStopsASettleMidway) {
+  // The cancel is polled inside every settle, not only between actions: the
+  // rest settle alone takes more than three solver steps, so the plan stops
+  // before its first action (polled only between actions, three would run).
+  const SurfaceParameters params = SurfaceParameters::paper_defaults(kPaper);
+  PlanCallbacks callbacks;
+  int polls = 0, snapshots = 0;
+  callbacks.cancelled = [&] { return ++polls > 3; };
+  callbacks.snapshot = [&](const DeviceState&) { ++snapshots; };
+  EXPECT_THROW(make_planner("algorithm2")->plan({kPaper, params, Eigen::MatrixXd::Constant(13, 17, 20.0), {}}, callbacks),
+               PlanCancelled);
+  EXPECT_EQ(snapshots, 0);
+  EXPECT_EQ(polls, 4);
+}
+
+TEST(Simulator, AnInterruptedActionLeavesTheStateAsItWas) {
+  int polls = 0;
+  bool armed = false;
+  SimulatorOptions options;
+  options.interrupted = [&] { return armed && ++polls > 2; };
+  Simulator sim(kPaper, SurfaceParameters::paper_defaults(kPaper), options);
+  const DeviceState before = sim.state();
+  armed = true;
+  EXPECT_THROW(sim.apply(Action::set_pressure(2000.0)), SettleInterrupted);
+  EXPECT_EQ(sim.state().pressure_pa, before.pressure_pa);
+  EXPECT_TRUE(sim.state().x == before.x);
+}
+
 }  // namespace
 }  // namespace hj

@@ -19,7 +19,14 @@ Algorithm2::Algorithm2(Algorithm2Options options) : options_(options) {
 
 PlanResult Algorithm2::plan(const PlanRequest& request, const PlanCallbacks& callbacks) const {
   validate_plan_request(request, Mesh(request.geometry));
-  Simulator sim(request.geometry, request.params, request.simulator);
+  auto start = [&] {
+    try {
+      return Simulator(request.geometry, request.params, simulator_options(request, callbacks));
+    } catch (const SettleInterrupted&) {
+      throw PlanCancelled();
+    }
+  };
+  Simulator sim = start();
   const Mesh& mesh = sim.mesh();
   const double p_max = options_.max_pressure_pa > 0.0 ? std::min(options_.max_pressure_pa, request.params.max_pressure_pa)
                                                       : request.params.max_pressure_pa;
@@ -33,7 +40,11 @@ PlanResult Algorithm2::plan(const PlanRequest& request, const PlanCallbacks& cal
   PlanResult result;
   auto apply = [&](const Action& action) {
     if (callbacks.cancelled && callbacks.cancelled()) throw PlanCancelled();
-    sim.apply(action);
+    try {
+      sim.apply(action);
+    } catch (const SettleInterrupted&) {
+      throw PlanCancelled();
+    }
     result.steps.push_back(action);
     if (callbacks.snapshot) callbacks.snapshot(sim.state());
   };

@@ -48,4 +48,10 @@ void validate_plan_request(const PlanRequest& request, const Mesh& mesh) {
   if (!g.allFinite()) throw std::invalid_argument("goal heights must all be finite numbers (mm)");
 }
 
+SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbacks& callbacks) {
+  SimulatorOptions options = request.simulator;
+  if (callbacks.cancelled) options.interrupted = callbacks.cancelled;
+  return options;
+}
+
 }  // namespace hj

@@ -58,6 +58,11 @@ std::unique_ptr<Planner> make_planner(const std::string& name);
 std::vector<std::string> planner_names();
 void register_planner(const std::string& name, std::function<std::unique_ptr<Planner>()> make);
 
+// The request's simulator options with callbacks.cancelled polled inside
+// every settle too, so a cancel stops a long settle, not only the plan
+// between actions (catch SettleInterrupted, throw PlanCancelled).
+SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbacks& callbacks);
+
 // Checks a request's goal against its mesh (shape, finite values).
 void validate_plan_request(const PlanRequest& request, const Mesh& mesh);
 

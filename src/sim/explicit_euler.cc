@@ -44,6 +44,7 @@ SettleReport settle_explicit(const ForceModel& model, DeviceState& state, const 
   Eigen::Matrix3Xd v = Eigen::Matrix3Xd::Zero(3, mesh.num_points()), f;
   SettleReport report;
   for (long step = 0; step < options.max_steps; ++step) {
+    if ((step & 1023) == 0 && options.interrupted && options.interrupted()) throw SettleInterrupted();
     model.forces(state, state.x, f);
     model.add_damping_forces(state, state.x, v, f);
     f -= drag * v;

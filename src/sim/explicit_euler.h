@@ -5,6 +5,8 @@
 // tolerances.
 #pragma once
 
+#include <functional>
+
 #include "model/device_state.h"
 #include "sim/force_model.h"
 #include "sim/settle_report.h"
@@ -24,6 +26,8 @@ struct ExplicitEulerOptions {
   double mean_speed_tolerance_m_per_s = 1e-8;
   double mean_accel_tolerance_m_per_s2 = 1e-6;
   long max_steps = 50'000'000;
+  // Polled every 1,024 steps; true throws SettleInterrupted.
+  std::function<bool()> interrupted;
 
   void validate() const;
 };

@@ -1,7 +1,16 @@
 // What a settle to static equilibrium did, for progress lines and benchmarks.
 #pragma once
 
+#include <stdexcept>
+
 namespace hj {
+
+// A settle stopped because its caller asked (SimulatorOptions::interrupted),
+// e.g. a client that cancelled or whose deadline passed.
+class SettleInterrupted : public std::runtime_error {
+ public:
+  SettleInterrupted() : std::runtime_error("the settle was interrupted") {}
+};
 
 struct SettleReport {
   bool converged = false;

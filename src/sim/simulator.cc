@@ -18,6 +18,7 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
     : options_(std::move(options)), model_(Mesh(geometry), params, make_effects(options_.extra_effects, options_.effect_parameters)) {
   options_.static_options.validate();
   options_.explicit_options.validate();
+  if (options_.interrupted) options_.static_options.interrupted = options_.explicit_options.interrupted = options_.interrupted;
   state_ = DeviceState::flat(model_.mesh());
   settle();
 }
@@ -81,7 +82,12 @@ const SettleReport& Simulator::apply(const Action& action) {
       state_.node_pinned[m.node_index(action.a, action.b)] = 0;
       break;
   }
-  settle();
+  try {
+    settle();
+  } catch (...) {
+    state_ = before;
+    throw;
+  }
   if (!last_.converged) {
     state_ = before;
     throw std::runtime_error("no static equilibrium found after " + action.describe() + " (residual " +

@@ -3,6 +3,7 @@
 // (docs/model.md, "States and actions").
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -29,6 +30,9 @@ struct SimulatorOptions {
   // values (effect name -> parameter name -> value; missing = default).
   std::vector<std::string> extra_effects;
   std::map<std::string, EffectParameterValues> effect_parameters;
+  // Polled while settling; true makes apply() throw SettleInterrupted with
+  // the state as it was before the action. Overrides the solvers' own.
+  std::function<bool()> interrupted;
 };
 
 class Simulator {
@@ -45,7 +49,8 @@ class Simulator {
 
   // Validates (std::invalid_argument naming what is wrong), applies and
   // settles. Repeating an action changes nothing. Throws std::runtime_error
-  // if no equilibrium is found (the state is left as it was).
+  // if no equilibrium is found, SettleInterrupted if interrupted (the state
+  // is left as it was in both cases).
   const SettleReport& apply(const Action& action);
 
  private:

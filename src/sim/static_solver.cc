@@ -94,6 +94,7 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
   Eigen::VectorXd residual = k.gather(f);
   double mu = mu0;
   for (int it = 0; it < max_iterations; ++it, ++report.iterations) {
+    if (options.interrupted && options.interrupted()) throw SettleInterrupted();
     report.residual_n = max_free_force(f, fixed);
     if (report.residual_n < options.force_tolerance_n) {
       if (!options.check_stability || report.restarts >= options.max_restarts) {

@@ -11,6 +11,8 @@
 // again.
 #pragma once
 
+#include <functional>
+
 #include "model/device_state.h"
 #include "sim/force_model.h"
 #include "sim/settle_report.h"
@@ -25,6 +27,8 @@ struct StaticSolverOptions {
   double max_step_fraction = 1.0;    // largest move of a point per step, in h
   int max_restarts = 6;              // pushes off unstable equilibria
   bool check_stability = true;
+  // Polled every step; true throws SettleInterrupted (state left mid-way).
+  std::function<bool()> interrupted;
 
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
