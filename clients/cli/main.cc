@@ -8,6 +8,7 @@
 
 #include "plan_command.h"
 #include "simulate_command.h"
+#include "sweep_command.h"
 
 namespace {
 
@@ -21,6 +22,7 @@ const std::vector<Command> kCommands = {
     {"simulate", hj::cli::run_simulate},
     {"demo", hj::cli::run_demo},
     {"plan", hj::cli::run_plan},
+    {"sweep", hj::cli::run_sweep_command},
 };
 
 constexpr const char* kUsage =
@@ -29,6 +31,7 @@ constexpr const char* kUsage =
     "  simulate SESSION.json --out DIR   replay a session's steps, write predicted frames\n"
     "  demo [--out DIR]                  simulate the paper's Fig. 7 sequence (embedded)\n"
     "  plan GOAL --rows R --cols C --out DIR   plan a goal shape (Algorithm 2)\n"
+    "  sweep GOAL... --out DIR           every goal at every array size, Figs. 11/13, Table 2\n"
     "run 'hapticjam COMMAND --help' for a command's options\n";
 
 }  // namespace
