@@ -1,8 +1,11 @@
 #include "shapes/sidecar.h"
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace hj {
 namespace {
