@@ -10,6 +10,7 @@
 #include "remote_command.h"
 #include "simulate_command.h"
 #include "synth_command.h"
+#include "sweep_command.h"
 
 namespace {
 
@@ -25,6 +26,7 @@ const std::vector<Command> kCommands = {
     {"plan", hj::cli::run_plan},
     {"synth", hj::cli::run_synth},
     {"remote", hj::cli::run_remote},
+    {"sweep", hj::cli::run_sweep_command},
 };
 
 constexpr const char* kUsage =
@@ -36,6 +38,7 @@ constexpr const char* kUsage =
     "  synth DATASET --out DIR           a synthetic dataset: DATASET's sessions replayed with a model + noise\n"
     "  remote SUBCOMMAND --server HOST:PORT    a client of hapticjam-server (plan, preview,\n"
     "                                    submit, watch, cancel, status, stop, resume ...)\n"
+    "  sweep GOAL... --out DIR           every goal at every array size, Figs. 11/13, Table 2\n"
     "run 'hapticjam COMMAND --help' for a command's options\n";
 
 }  // namespace

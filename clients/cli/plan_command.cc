@@ -15,6 +15,7 @@
 #include "metrics/laplace_predictor.h"
 #include "plan/planner.h"
 #include "progress.h"
+#include "shapes/geo_region.h"
 #include "shapes/goal_importer.h"
 #include "shapes/region.h"
 #include "shapes/resample.h"
@@ -28,8 +29,9 @@ constexpr const char* kPlanUsage =
     "usage: hapticjam plan GOAL --rows R --cols C --out DIR [--segments P] [--planner NAME]\n"
     "                      [--max-height-mm H] [--region x0,y0,x1,y1] [--hue] [--json]\n"
     "                      [--up-axis [-]x|y|z] [--view-resolution N]\n"
+    "                      [--region-lonlat lon0,lat0,lon1,lat1] [--encoding E] [--no-sidecar]\n"
     "Plans the actions that make the display show GOAL (a height image: CSV, PNG,\n"
-    "TIFF; or a mesh: STL, OBJ, PLY, glTF/GLB, 3MF, seen from above) and writes DIR/plan.json (steps in the session format, correlation,\n"
+    "TIFF or GeoTIFF, SRTM .hgt; or a mesh: STL, OBJ, PLY, glTF/GLB, 3MF, seen from above) and writes DIR/plan.json (steps in the session format, correlation,\n"
     "Laplace mean), DIR/predicted.csv and DIR/goal.csv (mm per mesh point, row i\n"
     "along +y) and DIR/compare.png.\n"
     "  --rows R, --cols C    array size in cells (38 mm cells)\n"
@@ -40,10 +42,14 @@ constexpr const char* kPlanUsage =
     "  --hue                 colour topographic map: red-orange high, blue-purple low\n"
     "  --json                print the summary as JSON\n"
     "  --up-axis A           a mesh's up axis: x, y, z (default), -x, -y or -z\n"
-    "  --view-resolution N   pixels of a mesh's top view along its longer side (default 256)\n";
+    "  --view-resolution N   pixels of a mesh's top view along its longer side (default 256)\n"
+    "  --region-lonlat B     zoom a georeferenced goal (GeoTIFF, .hgt, CSV with a sidecar\n"
+    "                        georef) to west,south,east,north in degrees (WGS 84)\n"
+    "  --encoding E          PNG pixels: grey (default), terrain-rgb (Mapbox) or terrarium\n"
+    "  --no-sidecar          ignore NAME.json beside the goal (it turns DEMs north-up)\n";
 
 struct PlanArgs {
-  std::string goal, out, planner = "algorithm2", region;
+  std::string goal, out, planner = "algorithm2", region, region_lonlat;
   int rows = 0, cols = 0, segments = 4;
   double max_height_mm = kDefaultMaxHeightMm;
   bool hue = false, json = false;
@@ -61,6 +67,9 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
     else if (a == "--segments") out.segments = parse_int(a, value(), 2, 1000);
     else if (a == "--planner") out.planner = value();
     else if (a == "--region") out.region = value();
+    else if (a == "--region-lonlat") out.region_lonlat = value(), (void)parse_lonlat_box(out.region_lonlat);
+    else if (a == "--encoding") out.import.encoding = parse_pixel_encoding(value());
+    else if (a == "--no-sidecar") out.import.sidecar = false;
     else if (a == "--hue") out.hue = true;
     else if (a == "--view-resolution") out.import.mesh_resolution = parse_int(a, value(), 1, 8192);
     else if (a == "--up-axis") {
@@ -82,6 +91,10 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
   if (out.goal.empty()) throw std::invalid_argument("missing GOAL");
   if (out.rows == 0 || out.cols == 0) throw std::invalid_argument("--rows and --cols are required");
   if (out.out.empty()) throw std::invalid_argument("missing --out DIR");
+  if (!out.region.empty() && !out.region_lonlat.empty())
+    throw std::invalid_argument("--region and --region-lonlat exclude each other");
+  if (out.hue && out.import.encoding != PixelEncoding::kGrey)
+    throw std::invalid_argument("--hue and --encoding exclude each other");
   return out;
 }
 
@@ -94,6 +107,7 @@ int plan(const PlanArgs& args) {
   import.hue = args.hue;
   HeightMap goal = import_goal(args.goal, import);
   if (!args.region.empty()) goal = crop(goal, parse_region(args.region));
+  if (!args.region_lonlat.empty()) goal = crop_lonlat(goal, parse_lonlat_box(args.region_lonlat));
   const ArrayGeometry geometry{args.rows, args.cols, 0.038, args.segments};
   const Mesh mesh(geometry);
   PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),

@@ -1,5 +1,7 @@
 #include "shapes/goal_importer.h"
 
+#include "shapes/sidecar.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -65,9 +67,18 @@ void ImportOptions::validate() const {
   if (mesh_up_axis != 'x' && mesh_up_axis != 'y' && mesh_up_axis != 'z')
     throw std::invalid_argument("ImportOptions.mesh_up_axis must be 'x', 'y' or 'z' (mesh_up_negative for -), got '" +
                                 std::string(1, mesh_up_axis) + "'");
+  if (hue && encoding != PixelEncoding::kGrey)
+    throw std::invalid_argument("ImportOptions.hue and ImportOptions.encoding (terrain-rgb / terrarium) exclude each other");
   if (mesh_resolution <= 0)
     throw std::invalid_argument("ImportOptions.mesh_resolution must be a positive pixel count, got " +
                                 std::to_string(mesh_resolution));
+}
+
+PixelEncoding parse_pixel_encoding(const std::string& name) {
+  if (name == "grey" || name == "gray") return PixelEncoding::kGrey;
+  if (name == "terrain-rgb") return PixelEncoding::kTerrainRgb;
+  if (name == "terrarium") return PixelEncoding::kTerrarium;
+  throw std::invalid_argument("unknown pixel encoding \"" + name + "\"; known: grey, terrain-rgb, terrarium");
 }
 
 void register_goal_importer(std::unique_ptr<GoalImporter> importer) {
@@ -100,6 +111,7 @@ HeightMap import_goal(const std::filesystem::path& file, const ImportOptions& op
   check_readable(file);
   HeightMap map = importer->import(file, options);
   check_result(file, map);
+  if (options.sidecar) apply_sidecar(file, map);
   return map;
 }
 

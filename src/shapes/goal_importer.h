@@ -12,10 +12,27 @@
 
 namespace hj {
 
+// How a PNG's pixels encode height. A PNG cannot say which, so it is the
+// caller's choice (plan --encoding).
+enum class PixelEncoding {
+  kGrey,        // grey level (or luminance, or hue with ImportOptions::hue) = height
+  kTerrainRgb,  // Mapbox Terrain-RGB: h = -10000 + (R 65536 + G 256 + B) 0.1 m
+  kTerrarium,   // Mapzen/AWS Terrarium: h = R 256 + G + B / 256 - 32768 m
+};
+
+// "grey", "terrain-rgb" or "terrarium"; std::invalid_argument otherwise.
+PixelEncoding parse_pixel_encoding(const std::string& name);
+
 struct ImportOptions {
   // Colour topographic map: height from hue, red-orange high, blue-purple low
   // (image_importer.cc documents the mapping). Off: colour -> luminance.
   bool hue = false;
+  // PNG tiles of elevation packed into RGB (terrain_rgb.h); kGrey otherwise.
+  // Only with hue off.
+  PixelEncoding encoding = PixelEncoding::kGrey;
+  // Read NAME.json beside the goal, if there is one (sidecar.h): its
+  // "orientation" turns the map north-up, its "georef" georeferences a CSV.
+  bool sidecar = true;
   // Refuse images or tables with more values than this (memory guard).
   long max_pixels = 50'000'000;
   // Meshes (mesh_importer.cc): the model axis that points up, 'x', 'y' or 'z',

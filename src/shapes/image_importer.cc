@@ -10,8 +10,9 @@
 #include <limits>
 #include <string>
 
-#include "shapes/goal_importer.h"
+#include "shapes/image_importer.h"
 #include "shapes/image_header.h"
+#include "shapes/terrain_rgb.h"
 
 namespace hj {
 namespace {
@@ -118,30 +119,40 @@ void apply_validmask(const std::filesystem::path& file, Eigen::MatrixXd& z) {
   z = (m.array() == 0.0).select(kNaN, z);
 }
 
-class ImageImporter final : public GoalImporter {
+class PngImporter final : public GoalImporter {
  public:
-  std::string name() const override { return "image"; }
-  std::vector<std::string> extensions() const override { return {".png", ".tif", ".tiff"}; }
-
+  std::string name() const override { return "png"; }
+  // TIFF goes through the GeoTIFF importer (geotiff_importer.cc), which
+  // hands plain TIFFs back to import_image.
+  std::vector<std::string> extensions() const override { return {".png"}; }
   HeightMap import(const std::filesystem::path& file, const ImportOptions& options) const override {
-    if (const auto size = peek_image_size(file)) check_pixel_count(file, size->rows, size->cols, options);
-    const cv::Mat image = decode(file);
-    check_pixel_count(file, image.rows, image.cols, options);
-    if (image.channels() > 4) throw ImportError(file, std::to_string(image.channels()) + " channels, at most 4 are understood");
-    HeightMap map;
-    map.z = options.hue ? hue_heights(file, image) : grey_heights(image);
-    apply_alpha(image, map.z);
-    apply_validmask(file, map.z);
-    if (map.z.array().isNaN().all())
-      throw ImportError(file, options.hue ? "no pixel has a clear hue (hue mode needs saturated colours)"
-                                          : "every pixel is NaN, transparent or masked out (no data)");
-    map.source = file.string();
-    return map;
+    return import_image(file, options);
   }
 };
 
 }  // namespace
 
-HJ_REGISTER_GOAL_IMPORTER(ImageImporter);
+HeightMap import_image(const std::filesystem::path& file, const ImportOptions& options) {
+  if (const auto size = peek_image_size(file)) check_pixel_count(file, size->rows, size->cols, options);
+  const cv::Mat image = decode(file);
+  check_pixel_count(file, image.rows, image.cols, options);
+  if (image.channels() > 4) throw ImportError(file, std::to_string(image.channels()) + " channels, at most 4 are understood");
+  HeightMap map;
+  if (options.encoding != PixelEncoding::kGrey) {
+    map.z = decode_terrain_rgb(file, image, options.encoding);
+    map.units = "m";
+  } else {
+    map.z = options.hue ? hue_heights(file, image) : grey_heights(image);
+    apply_alpha(image, map.z);
+  }
+  apply_validmask(file, map.z);
+  if (map.z.array().isNaN().all())
+    throw ImportError(file, options.hue ? "no pixel has a clear hue (hue mode needs saturated colours)"
+                                        : "every pixel is NaN, transparent or masked out (no data)");
+  map.source = file.string();
+  return map;
+}
+
+HJ_REGISTER_GOAL_IMPORTER(PngImporter);
 
 }  // namespace hj

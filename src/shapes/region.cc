@@ -76,8 +76,15 @@ HeightMap crop(const HeightMap& map, const Region& region) {
                                 std::to_string(cols) + " x " + std::to_string(rows) + " pixels");
   const Span x = region.fractions ? fraction_span(region.x0, region.x1, cols) : Span{long(region.x0), long(region.x1)};
   const Span y = region.fractions ? fraction_span(region.y0, region.y1, rows) : Span{long(region.y0), long(region.y1)};
-  HeightMap out;
+  HeightMap out = map;  // keeps units, uncovered_height and georef
   out.z = map.z.block(y.begin, x.begin, y.end - y.begin, x.end - x.begin);
+  if (out.georef) {
+    auto& gt = out.georef->geotransform;
+    const double dx = double(x.begin), dy = double(y.begin);
+    const double x0 = gt[0] + dx * gt[1] + dy * gt[2], y0 = gt[3] + dx * gt[4] + dy * gt[5];
+    gt[0] = x0;
+    gt[3] = y0;
+  }
   if (out.z.array().isNaN().all())
     throw std::invalid_argument("region " + describe(region) + " of goal \"" + map.source +
                                 "\" holds only no-data (NaN) pixels");

@@ -26,6 +26,8 @@ struct Region {
 Region parse_region(const std::string& text);
 
 // The part of `map` inside `region`; source gains " [crop x0,y0,x1,y1]".
+// Units, uncovered_height and the georeference (its origin moved to the
+// crop's corner) are kept.
 // @throws std::invalid_argument on an invalid region, one reaching outside
 //         the image, or one that holds no valid (non-NaN) pixel.
 HeightMap crop(const HeightMap& map, const Region& region);

@@ -1,8 +1,10 @@
 // Planning speed: Algorithm 2 for a real DEM (Maunga Whau) resampled to the
-// array. Run: ./build/hj_bench --benchmark_filter=Plan
+// array, a GeoTIFF DEM, and the sweep of one goal over array sizes.
+// Run: ./build/hj_bench --benchmark_filter="^BM_(Plan|Sweep)"
 #include <benchmark/benchmark.h>
 
 #include "plan/planner.h"
+#include "plan/sweep.h"
 #include "shapes/goal_importer.h"
 #include "shapes/resample.h"
 
@@ -18,5 +20,41 @@ void BM_PlanVolcanoDem(benchmark::State& state) {
 
 BENCHMARK(BM_PlanVolcanoDem)->Args({3, 4})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_PlanVolcanoDem)->Name("Slow/BM_PlanVolcanoDem")->Args({9, 12})->Unit(benchmark::kMillisecond)->Iterations(1);
+
+}  // namespace
+
+namespace {
+
+// The sweep of one goal (Maunga Whau, north-up by its sidecar) at the small
+// array sizes, on all cores; Slow/: the whole Table 1 list.
+void BM_SweepVolcano(benchmark::State& state, const char* sizes) {
+  const std::vector<hj::SweepGoal> goals{
+      {"volcano", hj::import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv")}};
+  hj::SweepOptions options;
+  options.sizes = hj::parse_array_sizes(sizes);
+  int ok = 0;
+  for (auto _ : state) {
+    ok = 0;
+    for (const auto& row : hj::run_sweep(goals, options)) ok += row.status == "ok";
+  }
+  state.counters["plans_ok"] = ok;
+}
+
+BENCHMARK_CAPTURE(BM_SweepVolcano, small, "2x2,3x4,4x6")->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_SweepVolcano, paper, "paper")
+    ->Name("Slow/BM_SweepVolcano/paper")
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+// One GeoTIFF DEM (Luxembourg, through GDAL, no-data outside the border) at 3 x 4.
+void BM_PlanLuxembourgGeoTiff(benchmark::State& state) {
+  const hj::ArrayGeometry g{3, 4, 0.038, 4};
+  const hj::HeightMap goal = hj::import_goal(HJ_SHARED_DIR "/data/dem/luxembourg_elev.tif");
+  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}};
+  const auto planner = hj::make_planner("algorithm2");
+  for (auto _ : state) benchmark::DoNotOptimize(planner->plan(request).steps.size());
+}
+BENCHMARK(BM_PlanLuxembourgGeoTiff)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace

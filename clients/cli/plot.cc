@@ -1,0 +1,98 @@
+#include "plot.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace hj::cli {
+namespace {
+
+constexpr int kWidth = 900, kHeight = 600;
+constexpr int kLeft = 80, kRight = 240, kTop = 50, kBottom = 70;
+
+// Tableau-like colours, BGR.
+const cv::Scalar kColours[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44},  {40, 39, 214},  {189, 103, 148},
+                               {75, 86, 140},  {194, 119, 227}, {127, 127, 127}, {34, 189, 188}, {207, 190, 23}};
+
+double nice_step(double range) {
+  const double raw = range / 5.0;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
+    if (m * mag >= raw) return m * mag;
+  return 10.0 * mag;
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+
+}  // namespace
+
+void write_plot_png(const std::filesystem::path& file, const std::string& title, const std::string& x_label,
+                    const std::string& y_label, const std::vector<PlotSeries>& series, const std::vector<PlotLine>& fits) {
+  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+  for (const auto& s : series)
+    for (const auto& [x, y] : s.points) x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  if (!std::isfinite(x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  if (x1 - x0 < 1e-9) x0 -= 0.5, x1 += 0.5;
+  if (y1 - y0 < 1e-9) y0 -= 0.05, y1 += 0.05;
+  const double xs = nice_step(x1 - x0), ys = nice_step(y1 - y0);
+  x0 = std::floor(x0 / xs) * xs, x1 = std::ceil(x1 / xs) * xs;
+  y0 = std::floor(y0 / ys) * ys, y1 = std::ceil(y1 / ys) * ys;
+  const int pw = kWidth - kLeft - kRight, ph = kHeight - kTop - kBottom;
+  const auto px = [&](double x) { return int(std::lround(kLeft + (x - x0) / (x1 - x0) * pw)); };
+  const auto py = [&](double y) { return int(std::lround(kTop + ph - (y - y0) / (y1 - y0) * ph)); };
+
+  cv::Mat img(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  const cv::Scalar black(0, 0, 0), grid(225, 225, 225);
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  for (double x = x0; x <= x1 + 1e-9 * xs; x += xs) {
+    cv::line(img, {px(x), kTop}, {px(x), kTop + ph}, grid, 1);
+    cv::putText(img, fmt(x), {px(x) - 12, kTop + ph + 20}, font, 0.45, black, 1, cv::LINE_AA);
+  }
+  for (double y = y0; y <= y1 + 1e-9 * ys; y += ys) {
+    cv::line(img, {kLeft, py(y)}, {kLeft + pw, py(y)}, grid, 1);
+    cv::putText(img, fmt(y), {kLeft - 50, py(y) + 5}, font, 0.45, black, 1, cv::LINE_AA);
+  }
+  cv::rectangle(img, {kLeft, kTop}, {kLeft + pw, kTop + ph}, black, 1);
+  cv::putText(img, title, {kLeft, 30}, font, 0.65, black, 1, cv::LINE_AA);
+  cv::putText(img, x_label, {kLeft + pw / 2 - 4 * int(x_label.size()), kHeight - 20}, font, 0.5, black, 1, cv::LINE_AA);
+  cv::Mat ylab(30, 8 * int(y_label.size()) + 20, CV_8UC3, cv::Scalar(255, 255, 255)), rotated;
+  cv::putText(ylab, y_label, {5, 20}, font, 0.5, black, 1, cv::LINE_AA);
+  cv::rotate(ylab, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
+  if (rotated.rows <= kHeight) rotated.copyTo(img(cv::Rect(2, std::max(0, kTop + ph / 2 - rotated.rows / 2), rotated.cols, rotated.rows)));
+
+  cv::Mat clip = img(cv::Rect(kLeft, kTop, pw + 1, ph + 1));
+  for (std::size_t k = 0; k < fits.size(); ++k) {
+    const auto& f = fits[k];
+    const cv::Point a{px(x0) - kLeft, py(f.slope * x0 + f.intercept) - kTop}, b{px(x1) - kLeft, py(f.slope * x1 + f.intercept) - kTop};
+    const double len = std::hypot(double(b.x - a.x), double(b.y - a.y));
+    for (double t = 0; t < len; t += 12) {  // dashed
+      const double t1 = std::min(len, t + 7);
+      cv::line(clip, a + (b - a) * (t / len), a + (b - a) * (t1 / len), black, 1, cv::LINE_AA);
+    }
+    cv::putText(img, f.label, {kLeft + 10, kTop + 20 + 20 * int(k)}, font, 0.5, black, 1, cv::LINE_AA);
+  }
+  for (std::size_t s = 0; s < series.size(); ++s) {
+    const cv::Scalar colour = kColours[s % std::size(kColours)];
+    auto pts = series[s].points;
+    if (series[s].lines) std::sort(pts.begin(), pts.end());
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const cv::Point p{px(pts[k].first), py(pts[k].second)};
+      cv::circle(img, p, 4, colour, cv::FILLED, cv::LINE_AA);
+      if (series[s].lines && k > 0) cv::line(img, {px(pts[k - 1].first), py(pts[k - 1].second)}, p, colour, 2, cv::LINE_AA);
+    }
+    const int ly = kTop + 10 + 22 * int(s);
+    cv::circle(img, {kLeft + pw + 20, ly}, 5, colour, cv::FILLED, cv::LINE_AA);
+    cv::putText(img, series[s].label.substr(0, 26), {kLeft + pw + 32, ly + 5}, font, 0.45, black, 1, cv::LINE_AA);
+  }
+  if (!cv::imwrite(file.string(), img)) throw std::runtime_error("cannot write " + file.string());
+}
+
+}  // namespace hj::cli

@@ -1,0 +1,172 @@
+#include "plan/algorithm2_refined.h"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <stdexcept>
+
+#include "metrics/correlation.h"
+#include "sim/surface_measures.h"
+
+namespace hj {
+
+namespace {
+
+struct Variant {
+  double scale, increment_pa;
+  bool jam_below_levelling;
+  bool bisect_pins;
+};
+
+// Bisection of a pressure step that carries a free node past its target by
+// more than max(kPinToleranceMm, kPinToleranceFraction * target relief):
+// back to the previous pressure with half the step, down to kMinStepPa.
+constexpr double kPinToleranceMm = 0.5;
+constexpr double kPinToleranceFraction = 0.02;
+constexpr double kMinStepPa = 1.0;
+// End pressures tried, as multiples of the levelling pressure, from high to low.
+constexpr double kEndPressureFactors[] = {4.0, 3.0, 2.0, 1.5, 1.25, 1.1, 1.02};
+
+// Algorithm 2 (algorithm2.cc) with the variant's knobs: targets scale * goal,
+// and, unless jam_below_levelling, no jam while the pressure is below the
+// levelling pressure.
+PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_max,
+                       const std::function<bool()>& cancelled) {
+  Simulator sim(request.geometry, request.params, request.simulator);
+  const Mesh& mesh = sim.mesh();
+  const double p_level = request.params.levelling_pressure_pa(mesh);
+  Eigen::Matrix3Xd goal_x = mesh.rest_positions();
+  for (int i = 0; i < mesh.point_rows(); ++i)
+    for (int j = 0; j < mesh.point_cols(); ++j) goal_x(2, mesh.index(i, j)) = v.scale * request.goal_mm(i, j) / 1000.0;
+  const Eigen::MatrixXd goal_curvature = cell_curvatures(mesh, goal_x);
+
+  PlanResult result;
+  auto apply = [&](const Action& action) {
+    if (cancelled && cancelled()) throw PlanCancelled();
+    sim.apply(action);
+    result.steps.push_back(action);
+  };
+  const double tolerance_m =
+      std::max(kPinToleranceMm, kPinToleranceFraction * v.scale * (request.goal_mm.maxCoeff() - request.goal_mm.minCoeff())) /
+      1000.0;
+  const auto overshoots = [&] {
+    for (int a = 1; a < mesh.rows(); ++a)
+      for (int b = 1; b < mesh.cols(); ++b) {
+        const int point = mesh.node_point(a, b);
+        if (!sim.state().pinned(mesh, a, b) && sim.state().x(2, point) > goal_x(2, point) + tolerance_m) return true;
+      }
+    return false;
+  };
+  double previous = 0.0, step = v.increment_pa;
+  while (previous < p_max) {
+    const double pressure = std::min(previous + step, p_max);
+    apply(Action::set_pressure(pressure));
+    if (v.bisect_pins && step > kMinStepPa && overshoots()) {
+      apply(Action::set_pressure(previous));
+      step /= 2.0;
+      continue;
+    }
+    previous = pressure;
+    const std::size_t steps_before = result.steps.size();
+    bool all_done = true;
+    for (int a = 1; a < mesh.rows(); ++a)
+      for (int b = 1; b < mesh.cols(); ++b) {
+        if (sim.state().pinned(mesh, a, b)) continue;
+        const int point = mesh.node_point(a, b);
+        if (sim.state().x(2, point) >= goal_x(2, point)) apply(Action::pin(a, b));
+        else all_done = false;
+      }
+    const bool may_jam = v.jam_below_levelling || pressure >= p_level;
+    for (int r = 0; r < mesh.rows(); ++r)
+      for (int c = 0; c < mesh.cols(); ++c) {
+        if (sim.state().jammed(mesh, r, c)) continue;
+        if (may_jam && cell_curvature(mesh, sim.state().x, r, c) >= goal_curvature(r, c)) apply(Action::jam(r, c));
+        else all_done = false;
+      }
+    if (all_done) break;
+    if (result.steps.size() > steps_before + 1) step = v.increment_pa;  // pinned or jammed: full steps again
+  }
+  // End pressure: with the pins and jams set, lower pressure lets the cells
+  // between pins relax from the bulge that lifting the highest nodes needed.
+  // Scan down towards the levelling pressure and end at the best one.
+  const auto score = [&] {
+    return correlate(request.goal_mm, point_heights(mesh, sim.state().x) * 1000.0).value.value_or(-INFINITY);
+  };
+  double best_pressure = sim.state().pressure_pa, best_r = score();
+  for (double f : kEndPressureFactors) {
+    const double p = f * p_level;
+    if (p >= sim.state().pressure_pa || p > p_max) continue;
+    apply(Action::set_pressure(p));
+    if (const double r = score(); r > best_r) best_r = r, best_pressure = p;
+  }
+  if (sim.state().pressure_pa != best_pressure) apply(Action::set_pressure(best_pressure));
+  result.final_state = sim.state();
+  return result;
+}
+
+}  // namespace
+
+void Algorithm2RefinedOptions::validate() const {
+  if (increments_pa.empty() || height_scales.empty() || jam_below_levelling.empty())
+    throw std::invalid_argument(
+        "Algorithm2RefinedOptions.height_scales, increments_pa and jam_below_levelling must not be empty");
+  for (double d : increments_pa)
+    if (!(d > 0.0) || !std::isfinite(d))
+      throw std::invalid_argument("Algorithm2RefinedOptions.increments_pa (Pa) must all be > 0");
+  for (double s : height_scales)
+    if (!(s > 0.0) || !std::isfinite(s))
+      throw std::invalid_argument("Algorithm2RefinedOptions.height_scales must all be > 0");
+  if (!(max_pressure_pa >= 0.0)) throw std::invalid_argument("Algorithm2RefinedOptions.max_pressure_pa (Pa) must be >= 0");
+}
+
+Algorithm2Refined::Algorithm2Refined(Algorithm2RefinedOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
+
+PlanResult Algorithm2Refined::plan(const PlanRequest& request, const PlanCallbacks& callbacks) const {
+  const Mesh mesh(request.geometry);
+  validate_plan_request(request, mesh);
+  const double p_max = options_.max_pressure_pa > 0.0 ? std::min(options_.max_pressure_pa, request.params.max_pressure_pa)
+                                                      : request.params.max_pressure_pa;
+  std::vector<Variant> variants;
+  for (double s : options_.height_scales)
+    for (double d : options_.increments_pa)
+      for (bool j : options_.jam_below_levelling)
+        for (bool b : options_.bisect_pins) variants.push_back({s, d, j, b});
+
+  std::optional<PlanResult> best;
+  double best_r = -INFINITY;
+  std::string last_error;
+  for (std::size_t k = 0; k < variants.size(); ++k) {
+    const Variant& v = variants[k];
+    if (callbacks.progress) {
+      char what[96];
+      std::snprintf(what, sizeof what, "variant %zu/%zu: scale %g, %g Pa steps%s", k + 1, variants.size(), v.scale,
+                    v.increment_pa, v.jam_below_levelling ? "" : ", jam above levelling");
+      callbacks.progress(double(k) / double(variants.size()), what);
+    }
+    PlanResult candidate;
+    try {
+      candidate = run_variant(request, v, p_max, callbacks.cancelled);
+    } catch (const PlanCancelled&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      last_error = e.what();  // no equilibrium on this path: the other variants may find one
+      continue;
+    }
+    const Correlation c = correlate(request.goal_mm, point_heights(mesh, candidate.final_state.x) * 1000.0);
+    const double r = c.value.value_or(-INFINITY);
+    if (!best || r > best_r) best_r = r, best = std::move(candidate);
+  }
+  if (!best) throw std::runtime_error("algorithm2-refined: no variant reached equilibrium: " + last_error);
+  if (callbacks.progress) callbacks.progress(1.0, "best variant chosen");
+  if (callbacks.snapshot) callbacks.snapshot(best->final_state);
+  return std::move(*best);
+}
+
+namespace {
+const bool registered =
+    (register_planner("algorithm2-refined", [] { return std::make_unique<Algorithm2Refined>(); }), true);
+}  // namespace
+
+}  // namespace hj

@@ -1,0 +1,164 @@
+#include "plan/sweep.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "metrics/correlation.h"
+#include "model/mesh.h"
+#include "plan/planner.h"
+#include "shapes/resample.h"
+#include "sim/surface_measures.h"
+
+namespace hj {
+
+std::vector<ArraySize> paper_array_sizes() { return {{2, 2}, {3, 4}, {4, 6}, {6, 8}, {9, 12}}; }
+
+std::vector<double> table2_alphas() { return {0.0, 1.0 / 6.0, 1.0 / 3.0, 0.5, 1.0}; }
+
+std::vector<ArraySize> parse_array_sizes(const std::string& text) {
+  if (text == "paper") return paper_array_sizes();
+  std::vector<ArraySize> out;
+  std::istringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    const auto x = item.find_first_of("xX");
+    int r = 0, c = 0;
+    try {
+      std::size_t used_r = 0, used_c = 0;
+      if (x == std::string::npos) throw std::invalid_argument("no x");
+      r = std::stoi(item.substr(0, x), &used_r);
+      c = std::stoi(item.substr(x + 1), &used_c);
+      if (used_r != x || used_c != item.size() - x - 1) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      throw std::invalid_argument("array sizes \"" + text + "\": \"" + item + "\" is not RxC (e.g. 3x4), or use \"paper\"");
+    }
+    if (r < 1 || c < 1 || r > 100 || c > 100)
+      throw std::invalid_argument("array sizes \"" + text + "\": \"" + item + "\" must have 1..100 rows and columns");
+    out.push_back({r, c});
+  }
+  if (out.empty()) throw std::invalid_argument("array sizes \"" + text + "\": no size given");
+  return out;
+}
+
+void SweepOptions::validate() const {
+  if (sizes.empty()) throw std::invalid_argument("SweepOptions.sizes must not be empty");
+  if (segments < 2) throw std::invalid_argument("SweepOptions.segments must be >= 2");
+  if (!(max_height_mm > 0.0) || !std::isfinite(max_height_mm))
+    throw std::invalid_argument("SweepOptions.max_height_mm must be a positive number of mm");
+  if (jobs < 0) throw std::invalid_argument("SweepOptions.jobs must be >= 0 (0: one per core)");
+  if (fallback_max_steps < 0) throw std::invalid_argument("SweepOptions.fallback_max_steps must be >= 0 (0: the default)");
+  if (!(budget_s > 0.0)) throw std::invalid_argument("SweepOptions.budget_s must be a positive number of seconds");
+  for (double a : alphas)
+    if (!(a >= 0.0 && a <= 1.0)) throw std::invalid_argument("SweepOptions.alphas must lie in [0, 1]");
+  (void)make_planner(planner);  // names the known planners if unknown
+}
+
+namespace {
+
+SweepRow run_one(const SweepGoal& goal, ArraySize size, const SweepOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  SweepRow row;
+  row.goal = goal.name;
+  row.rows = size.rows;
+  row.cols = size.cols;
+  const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  try {
+    const ArrayGeometry geometry{size.rows, size.cols, 0.038, options.segments};
+    const Mesh mesh(geometry);
+    PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),
+                        resample_to_mesh(goal.map, mesh, options.max_height_mm), {}};
+    if (options.fallback_max_steps > 0) request.simulator.fallback_max_steps = options.fallback_max_steps;
+    for (double a : options.alphas) row.laplace_mean.push_back(laplace_mean(request.goal_mm, a));
+    PlanCallbacks callbacks;
+    callbacks.cancelled = [&] { return elapsed() > options.budget_s; };
+    const PlanResult result = make_planner(options.planner)->plan(request, callbacks);
+    row.steps = int(result.steps.size());
+    // Mesh rows run along +y; the goal image's row 0 is its top.
+    const Eigen::MatrixXd predicted_image = (point_heights(mesh, result.final_state.x) * 1000.0).colwise().reverse();
+    const Correlation corr = correlate_with_goal(goal.map.z, predicted_image);
+    row.correlation = corr.value;
+    row.status = corr.value ? "ok" : "undefined";
+    row.detail = corr.undefined_reason;
+  } catch (const PlanCancelled&) {
+    row.status = "over-budget";
+    std::ostringstream s;
+    s << "stopped after " << options.budget_s << " s (budget)";
+    row.detail = s.str();
+  } catch (const std::exception& e) {
+    row.status = "failed";
+    row.detail = e.what();
+  }
+  row.seconds = elapsed();
+  return row;
+}
+
+}  // namespace
+
+std::vector<SweepRow> run_sweep(const std::vector<SweepGoal>& goals, const SweepOptions& options,
+                                const std::function<void(int, int, const SweepRow&)>& progress) {
+  options.validate();
+  struct Task {
+    std::size_t goal, size;
+  };
+  std::vector<Task> tasks;
+  for (std::size_t g = 0; g < goals.size(); ++g)
+    for (std::size_t s = 0; s < options.sizes.size(); ++s) tasks.push_back({g, s});
+  std::vector<SweepRow> rows(tasks.size());
+  // Largest arrays first, so a slow one does not start last and leave the other cores idle.
+  std::vector<std::size_t> order(tasks.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const auto& sa = options.sizes[tasks[a].size];
+    const auto& sb = options.sizes[tasks[b].size];
+    return sa.rows * sa.cols > sb.rows * sb.cols;
+  });
+
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;
+  int done = 0;
+  const auto worker = [&] {
+    for (std::size_t k; (k = next.fetch_add(1)) < order.size();) {
+      const Task& t = tasks[order[k]];
+      SweepRow row = run_one(goals[t.goal], options.sizes[t.size], options);
+      const std::lock_guard<std::mutex> lock(mutex);
+      rows[order[k]] = std::move(row);
+      ++done;
+      if (progress) progress(done, int(tasks.size()), rows[order[k]]);
+    }
+  };
+  const int jobs = std::max(1, std::min<int>(options.jobs > 0 ? options.jobs : int(std::thread::hardware_concurrency()),
+                                             int(tasks.size())));
+  std::vector<std::thread> pool;
+  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  return rows;
+}
+
+std::vector<Table2Row> table2(const std::vector<SweepRow>& rows, const std::vector<double>& alphas) {
+  std::vector<Table2Row> out;
+  for (std::size_t a = 0; a < alphas.size(); ++a) {
+    std::vector<double> x, y;
+    for (const auto& r : rows)
+      if (r.correlation && a < r.laplace_mean.size()) {
+        x.push_back(r.laplace_mean[a]);
+        y.push_back(*r.correlation);
+      }
+    Table2Row t{alphas[a], std::nullopt};
+    try {
+      t.fit = fit_line(x, y);
+    } catch (const std::invalid_argument&) {
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace hj
