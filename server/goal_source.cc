@@ -18,7 +18,7 @@ namespace {
 // `file_name` (the importer picks the format by it), removed on destruction.
 class TemporaryGoalFile {
  public:
-  TemporaryGoalFile(const std::string& bytes, const std::string& file_name) {
+  TemporaryGoalFile(const std::string& bytes, const std::string& file_name, const std::string& sidecar) {
     static std::atomic<long> counter{0};
     const std::string extension = std::filesystem::path(file_name).extension().string();
     path_ = std::filesystem::temp_directory_path() /
@@ -26,22 +26,34 @@ class TemporaryGoalFile {
     std::ofstream out(path_, std::ios::binary);
     out.write(bytes.data(), std::streamsize(bytes.size()));
     if (!out) throw std::runtime_error("cannot write the goal to a temporary file " + path_.string());
+    if (!sidecar.empty()) {
+      // Beside it as NAME.json, where the importer looks for a sidecar.
+      sidecar_ = std::filesystem::path(path_).replace_extension(".json");
+      std::ofstream side(sidecar_, std::ios::binary);
+      side.write(sidecar.data(), std::streamsize(sidecar.size()));
+      if (!side) throw std::runtime_error("cannot write the goal's sidecar to " + sidecar_.string());
+    }
   }
   ~TemporaryGoalFile() {
     std::error_code ignored;
     std::filesystem::remove(path_, ignored);
+    if (!sidecar_.empty()) std::filesystem::remove(sidecar_, ignored);
   }
   const std::filesystem::path& path() const { return path_; }
 
  private:
   std::filesystem::path path_;
+  std::filesystem::path sidecar_;
 };
 
 HeightMap import_bytes(const hapticjam::v1::GoalFile& file, const ImportOptions& options) {
   if (file.file_name().empty())
     throw std::invalid_argument("goal.file.file_name is empty: its extension names the format (e.g. \"part.stl\")");
   if (file.content().empty()) throw std::invalid_argument("goal.file.content is empty");
-  const TemporaryGoalFile temporary(file.content(), file.file_name());
+  if (std::filesystem::path(file.file_name()).extension() == ".json")
+    throw std::invalid_argument("goal.file.file_name \"" + file.file_name() +
+                                "\": a .json file is a sidecar; send it as goal.file.sidecar_json");
+  const TemporaryGoalFile temporary(file.content(), file.file_name(), file.sidecar_json());
   try {
     HeightMap map = import_goal(temporary.path(), options);
     map.source = file.file_name();
@@ -52,6 +64,10 @@ HeightMap import_bytes(const hapticjam::v1::GoalFile& file, const ImportOptions&
     const std::string tmp = temporary.path().string();
     for (auto at = what.find(tmp); at != std::string::npos; at = what.find(tmp))
       what.replace(at, tmp.size(), file.file_name());
+    const std::string side = std::filesystem::path(temporary.path()).replace_extension(".json").string();
+    const std::string side_name = std::filesystem::path(file.file_name()).replace_extension(".json").string();
+    for (auto at = what.find(side); at != std::string::npos; at = what.find(side))
+      what.replace(at, side.size(), side_name);
     const std::string prefix = "cannot import goal \"" + file.file_name() + "\": ";
     throw ImportError(file.file_name(), what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what);
   }

@@ -42,6 +42,7 @@ bool GoalArgs::take(ArgCursor& cursor) {
     region = cursor.value();
     parse_region_flag(region);
   } else if (a == "--hue") hue = true;
+  else if (a == "--no-sidecar") use_sidecar = false;
   else if (a == "--up-axis") {
     up_axis = cursor.value();
     const std::string axis = !up_axis.empty() && up_axis[0] == '-' ? up_axis.substr(1) : up_axis;
@@ -75,6 +76,15 @@ v1::Goal GoalArgs::goal() const {
     bytes << in.rdbuf();
     g.mutable_file()->set_content(bytes.str());
     g.mutable_file()->set_file_name(std::filesystem::path(file).filename().string());
+    // NAME.json beside the goal goes along, as a local plan would read it.
+    const std::filesystem::path sidecar = std::filesystem::path(file).replace_extension(".json");
+    if (use_sidecar && sidecar != std::filesystem::path(file) && std::filesystem::exists(sidecar)) {
+      std::ifstream side(sidecar, std::ios::binary);
+      std::ostringstream side_bytes;
+      side_bytes << side.rdbuf();
+      if (!side) throw std::runtime_error("cannot read the goal's sidecar \"" + sidecar.string() + "\"");
+      g.mutable_file()->set_sidecar_json(side_bytes.str());
+    }
   }
   if (!region.empty()) *g.mutable_region() = parse_region_flag(region);
   v1::GoalOptions* o = g.mutable_options();

@@ -20,6 +20,7 @@ constexpr const char* kRemoteGoalUsage =
     "  --max-height-mm H     goal height range on the display (default 30 mm)\n"
     "  --region x0,y0,x1,y1  zoom: pixels, or fractions of the image if all <= 1\n"
     "  --hue                 colour topographic map: red-orange high, blue-purple low\n"
+    "  --no-sidecar          do not send NAME.json beside the goal (it turns DEMs north-up)\n"
     "  --up-axis A           a mesh's up axis: x, y, z (default), -x, -y or -z\n"
     "  --view-resolution N   pixels of a mesh's top view along its longer side (default 256)\n";
 
@@ -28,6 +29,7 @@ struct GoalArgs {
   int rows = 0, cols = 0, segments = 0, view_resolution = 0;
   double cell_mm = 0.0, max_height_mm = 0.0;
   bool hue = false;
+  bool use_sidecar = true;  // send NAME.json beside the goal (--no-sidecar: do not)
 
   // Consumes one goal or array flag, or the GOAL argument; false if the
   // argument is not one of them. @throws std::invalid_argument on a bad value.

@@ -32,7 +32,9 @@ constexpr double kEndPressureFactors[] = {4.0, 3.0, 2.0, 1.5, 1.25, 1.1, 1.02};
 // levelling pressure.
 PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_max,
                        const std::function<bool()>& cancelled) {
-  Simulator sim(request.geometry, request.params, request.simulator);
+  SimulatorOptions options = request.simulator;
+  if (cancelled) options.interrupted = cancelled;  // stops a long settle midway (SettleInterrupted)
+  Simulator sim(request.geometry, request.params, options);
   const Mesh& mesh = sim.mesh();
   const double p_level = request.params.levelling_pressure_pa(mesh);
   Eigen::Matrix3Xd goal_x = mesh.rest_positions();
@@ -150,6 +152,8 @@ PlanResult Algorithm2Refined::plan(const PlanRequest& request, const PlanCallbac
       candidate = run_variant(request, v, p_max, callbacks.cancelled);
     } catch (const PlanCancelled&) {
       throw;
+    } catch (const SettleInterrupted&) {
+      throw PlanCancelled();
     } catch (const std::runtime_error& e) {
       last_error = e.what();  // no equilibrium on this path: the other variants may find one
       continue;
