@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "compare_command.h"
+#include "diagnose_command.h"
+#include "fit_command.h"
 #include "plan_command.h"
 #include "simulate_command.h"
 
@@ -21,6 +24,9 @@ const std::vector<Command> kCommands = {
     {"simulate", hj::cli::run_simulate},
     {"demo", hj::cli::run_demo},
     {"plan", hj::cli::run_plan},
+    {"compare", hj::cli::run_compare},
+    {"fit", hj::cli::run_fit},
+    {"diagnose", hj::cli::run_diagnose},
 };
 
 constexpr const char* kUsage =
@@ -29,6 +35,9 @@ constexpr const char* kUsage =
     "  simulate SESSION.json --out DIR   replay a session's steps, write predicted frames\n"
     "  demo [--out DIR]                  simulate the paper's Fig. 7 sequence (embedded)\n"
     "  plan GOAL --rows R --cols C --out DIR   plan a goal shape (Algorithm 2)\n"
+    "  compare DATASET --out DIR         model versus measured frames: errors, heat maps, report\n"
+    "  fit DATASET --out DIR             fit the model's parameters to a dataset (params.json)\n"
+    "  diagnose DATASET --out DIR        find the effect(s) the model is missing\n"
     "run 'hapticjam COMMAND --help' for a command's options\n";
 
 }  // namespace

@@ -5,18 +5,26 @@
 namespace hj {
 
 std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,
-                                             const SimulatorOptions& options, const ReplayProgress& progress) {
+                                             const SimulatorOptions& options, const ReplayProgress& progress,
+                                             const ReplayTrace* warm_start, ReplayTrace* trace) {
   params.max_pressure_pa = session.device.max_pressure_kpa * 1000.0;
   Simulator sim(session.device.geometry(segments), params, options);
   std::vector<PredictedCapture> captures;
   const int total = static_cast<int>(session.steps.size());
+  if (warm_start && static_cast<int>(warm_start->size()) != total)
+    throw std::invalid_argument("replay_session: the warm start has " + std::to_string(warm_start->size()) +
+                                " steps, " + session.name + " " + std::to_string(total));
+  if (trace) trace->assign(total, Eigen::Matrix3Xd());
   for (int i = 0; i < total; ++i) {
     const SessionStep& step = session.steps[i];
     if (step.kind == SessionStep::Kind::kCapture) {
       captures.push_back({step.index, step.frame, step.label, rasterize_top_view(sim.mesh(), sim.state().x, session.grid)});
     } else {
       try {
-        sim.apply(step.action);
+        const Eigen::Matrix3Xd* start = warm_start ? &(*warm_start)[i] : nullptr;
+        if (start && start->cols() == sim.state().x.cols()) sim.apply(step.action, *start);
+        else sim.apply(step.action);
+        if (trace) (*trace)[i] = sim.state().x;
       } catch (const std::exception& e) {
         throw SessionError(session.name + ": steps[" + std::to_string(step.index) + "] (" + step.action.op_name() +
                            "): " + e.what());

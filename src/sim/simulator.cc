@@ -40,7 +40,16 @@ void Simulator::settle() {
   last_.seconds += dynamic.seconds;
 }
 
-const SettleReport& Simulator::apply(const Action& action) {
+const SettleReport& Simulator::apply(const Action& action) { return apply_from(action, nullptr); }
+
+const SettleReport& Simulator::apply(const Action& action, const Eigen::Matrix3Xd& start) {
+  if (start.cols() != state_.x.cols())
+    throw std::invalid_argument("Simulator::apply: start has " + std::to_string(start.cols()) + " points, the mesh " +
+                                std::to_string(state_.x.cols()));
+  return apply_from(action, &start);
+}
+
+const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Matrix3Xd* start) {
   action.validate(mesh(), params());
   const DeviceState before = state_;
   const Mesh& m = mesh();
@@ -68,7 +77,15 @@ const SettleReport& Simulator::apply(const Action& action) {
       state_.node_pinned[m.node_index(action.a, action.b)] = 0;
       break;
   }
-  settle();
+  if (start) {
+    const Eigen::Matrix3Xd cold = state_.x;
+    const std::vector<char> fixed = state_.fixed_points(m);
+    for (int p = 0; p < m.num_points(); ++p)
+      if (!fixed[p]) state_.x.col(p) = start->col(p);
+    settle();
+    if (!last_.converged) state_.x = cold;
+  }
+  if (!start || !last_.converged) settle();
   if (!last_.converged) {
     state_ = before;
     throw std::runtime_error("no static equilibrium found after " + action.describe() + " (residual " +

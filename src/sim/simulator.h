@@ -47,9 +47,15 @@ class Simulator {
   // settles. Repeating an action changes nothing. Throws std::runtime_error
   // if no equilibrium is found (the state is left as it was).
   const SettleReport& apply(const Action& action);
+  // As apply(action), but the settle starts with the free points at `start`
+  // (3 x N), e.g. the settled state of the same step under nearby
+  // parameters, which a fit's Jacobian replays many times; fixed and pinned
+  // points stay. If that does not settle, settles from the usual start.
+  const SettleReport& apply(const Action& action, const Eigen::Matrix3Xd& start);
 
  private:
   void settle();
+  const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
   SimulatorOptions options_;
   ForceModel model_;

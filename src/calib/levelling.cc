@@ -1,0 +1,53 @@
+#include "calib/levelling.h"
+
+#include <cmath>
+
+namespace hj {
+
+double centre_height_mm(const Session& session, const MeasuredCapture& capture) {
+  const double s = session.device.cell_size_mm;
+  const double cx = session.device.cols * s / 2.0, cy = session.device.rows * s / 2.0;
+  double sum = 0.0;
+  int n = 0;
+  for (int iy = 0; iy < session.grid.ny; ++iy)
+    for (int ix = 0; ix < session.grid.nx; ++ix) {
+      const double h = capture.heights_mm(iy, ix);
+      if (std::isnan(h) || std::hypot(session.grid.x_mm(ix) - cx, session.grid.y_mm(iy) - cy) > s / 4.0) continue;
+      sum += h;
+      ++n;
+    }
+  return n ? sum / n : std::nan("");
+}
+
+LevellingEstimate levelling_mass(const Dataset& dataset, double gravity) {
+  LevellingEstimate out;
+  for (const MeasuredSession& measured : dataset.sessions) {
+    const Session& session = measured.session;
+    const MeasuredCapture* previous = nullptr;
+    double previous_h = 0.0;
+    for (const MeasuredCapture& capture : measured.captures) {
+      if (capture.jammed_count() > 0 || !capture.pinned.empty()) {
+        previous = nullptr;
+        continue;
+      }
+      const double h = centre_height_mm(session, capture);
+      if (std::isnan(h)) continue;
+      if (previous && capture.pressure_pa > previous->pressure_pa && previous_h < 0.0 && h >= 0.0) {
+        const double a = std::pow(previous_h, 3), b = std::pow(h, 3);
+        out.found = true;
+        out.pressure_pa = previous->pressure_pa + (capture.pressure_pa - previous->pressure_pa) * (-a) / (b - a);
+        const double area_m2 = session.device.rows * session.device.cols * std::pow(session.device.cell_size_mm / 1000.0, 2);
+        out.mass_kg = out.pressure_pa * area_m2 / gravity;
+        out.session = session.name;
+        out.below_pa = previous->pressure_pa;
+        out.above_pa = capture.pressure_pa;
+        return out;
+      }
+      previous = &capture;
+      previous_h = h;
+    }
+  }
+  return out;
+}
+
+}  // namespace hj
