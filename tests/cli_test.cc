@@ -3,9 +3,8 @@
 // or option exits non-zero with a message naming what is wrong.
 #include <gtest/gtest.h>
 
+#include "cli_runner.h"
 #include "scratch_dir.h"
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -27,28 +26,9 @@ const fs::path kPaperSequence = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-ba
 
 using testing_support::ScratchDir;
 
-std::string quoted(const fs::path& p) {
-  std::string out(1, '\'');
-  out += p.string();
-  out += '\'';
-  return out;
-}
-
-// Runs the CLI with `args`, stdout and stderr to files in `dir`; returns
-// the exit code (-1 if it did not exit normally).
-int run_cli(const std::string& args, const fs::path& dir) {
-  const std::string command = quoted(HJ_CLI_PATH) + " " + args + " >" + quoted(dir / "stdout.txt") + " 2>" +
-                              quoted(dir / "stderr.txt");
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using testing_support::quoted;
+using testing_support::read_text;
+using testing_support::run_cli;
 
 const std::string kTrueParameters = " --mass 0.52 --k 58 --kappa-jam 4.2";
 

@@ -16,6 +16,7 @@
 #include "sim/force_model.h"
 #include "sim/simulator.h"
 #include "sim/stiffness_matrix.h"
+#include "effect_checks.h"
 
 namespace hj {
 namespace {
@@ -27,11 +28,7 @@ const ArrayGeometry kPaper{3, 4, 0.038, 4};
 // are stretched unevenly and jammed cells sit away from their rest angles.
 DeviceState perturbed_jammed_state(const Simulator& sim, std::mt19937& rng) {
   DeviceState state = sim.state();
-  const std::vector<char> fixed = state.fixed_points(sim.mesh());
-  std::normal_distribution<double> move(0.0, 1e-3);
-  for (int p = 0; p < sim.mesh().num_points(); ++p)
-    if (!fixed[p])
-      for (int c = 0; c < 3; ++c) state.x(c, p) += move(rng);
+  state.x = testing_support::perturbed(state.x, state.fixed_points(sim.mesh()), rng);
   return state;
 }
 
@@ -49,14 +46,6 @@ const Effect& effect_named(const ForceModel& model, const std::string& name) {
   throw std::logic_error("no effect " + name);
 }
 
-// Free-DOF force vector of one effect at positions x.
-Eigen::VectorXd effect_force(const Effect& effect, const ForceContext& ctx, const Eigen::Matrix3Xd& x,
-                             const StiffnessMatrix& k) {
-  Eigen::Matrix3Xd f = Eigen::Matrix3Xd::Zero(3, x.cols());
-  effect.add_forces(ctx, x, f);
-  return k.gather(f);
-}
-
 class EffectDerivatives : public testing::TestWithParam<const char*> {};
 
 TEST_P(EffectDerivatives, StiffnessIsMinusTheForceJacobian) {
@@ -66,33 +55,13 @@ TEST_P(EffectDerivatives, StiffnessIsMinusTheForceJacobian) {
   const Mesh& mesh = sim.mesh();
   const Effect& effect = effect_named(sim.model(), GetParam());
   const ForceContext ctx{mesh, sim.params(), state};
-
-  StiffnessMatrix k(mesh, state.fixed_points(mesh),
-                    [&](StiffnessSink& sink) { effect.add_stiffness(ctx, state.x, sink); });
-  k.set_zero();
-  effect.add_stiffness(ctx, state.x, k);
-  const Eigen::MatrixXd analytic = Eigen::MatrixXd(k.matrix());
-
-  const int n = k.num_dofs();
-  Eigen::MatrixXd numeric(n, n);
-  const double eps = 1e-6;  // m
-  Eigen::Matrix3Xd x = state.x;
-  for (int d = 0; d < n; ++d) {
-    const int point = k.free_points()[d / 3], c = d % 3;
-    const double x0 = x(c, point);
-    x(c, point) = x0 + eps;
-    const Eigen::VectorXd plus = effect_force(effect, ctx, x, k);
-    x(c, point) = x0 - eps;
-    const Eigen::VectorXd minus = effect_force(effect, ctx, x, k);
-    x(c, point) = x0;
-    numeric.col(d) = -(plus - minus) / (2.0 * eps);
-  }
-  const double error = (analytic - numeric).norm();
-  EXPECT_LE(error, 1e-5 * analytic.norm()) << GetParam() << ": |K - K_fd| = " << error << ", |K| = " << analytic.norm();
+  const auto check = testing_support::check_stiffness(effect, ctx, state.fixed_points(mesh));
+  EXPECT_LE(check.error(), 1e-5 * check.analytic.norm())
+      << GetParam() << ": |K - K_fd| = " << check.error() << ", |K| = " << check.analytic.norm();
   if (std::string(GetParam()) == "gravity") {
-    EXPECT_EQ(numeric.norm(), 0.0) << "a constant weight has no stiffness";
+    EXPECT_EQ(check.numeric.norm(), 0.0) << "a constant weight has no stiffness";
   } else {
-    EXPECT_GT(analytic.norm(), 0.0);
+    EXPECT_GT(check.analytic.norm(), 0.0);
   }
 }
 
@@ -107,25 +76,10 @@ TEST_P(EffectDerivatives, ConservativeForceIsMinusTheEnergyGradient) {
     EXPECT_EQ(std::string(GetParam()), "pressure") << "only the follower load has no energy";
     return;
   }
-  StiffnessMatrix k(mesh, state.fixed_points(mesh), [](StiffnessSink&) {});
-  const Eigen::VectorXd force = effect_force(effect, ctx, state.x, k);
-
-  Eigen::VectorXd minus_grad(k.num_dofs());
-  const double eps = 1e-6;  // m
-  Eigen::Matrix3Xd x = state.x;
-  for (int d = 0; d < k.num_dofs(); ++d) {
-    const int point = k.free_points()[d / 3], c = d % 3;
-    const double x0 = x(c, point);
-    x(c, point) = x0 + eps;
-    const double e_plus = *effect.energy(ctx, x);
-    x(c, point) = x0 - eps;
-    const double e_minus = *effect.energy(ctx, x);
-    x(c, point) = x0;
-    minus_grad(d) = -(e_plus - e_minus) / (2.0 * eps);
-  }
-  ASSERT_GT(force.norm(), 0.0);
-  EXPECT_LE((force - minus_grad).norm(), 1e-6 * force.norm())
-      << GetParam() << ": |F| = " << force.norm() << ", |F + grad E| = " << (force - minus_grad).norm();
+  const auto check = testing_support::check_energy_gradient(effect, ctx, state.fixed_points(mesh));
+  ASSERT_GT(check.force.norm(), 0.0);
+  EXPECT_LE(check.error(), 1e-6 * check.force.norm())
+      << GetParam() << ": |F| = " << check.force.norm() << ", |F + grad E| = " << check.error();
 }
 
 INSTANTIATE_TEST_SUITE_P(Baseline, EffectDerivatives, testing::Values("springs", "gravity", "pressure", "jamming"),

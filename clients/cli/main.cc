@@ -11,6 +11,7 @@
 #include "fit_command.h"
 #include "plan_command.h"
 #include "simulate_command.h"
+#include "synth_command.h"
 
 namespace {
 
@@ -24,6 +25,7 @@ const std::vector<Command> kCommands = {
     {"simulate", hj::cli::run_simulate},
     {"demo", hj::cli::run_demo},
     {"plan", hj::cli::run_plan},
+    {"synth", hj::cli::run_synth},
     {"compare", hj::cli::run_compare},
     {"fit", hj::cli::run_fit},
     {"diagnose", hj::cli::run_diagnose},
@@ -35,6 +37,7 @@ constexpr const char* kUsage =
     "  simulate SESSION.json --out DIR   replay a session's steps, write predicted frames\n"
     "  demo [--out DIR]                  simulate the paper's Fig. 7 sequence (embedded)\n"
     "  plan GOAL --rows R --cols C --out DIR   plan a goal shape (Algorithm 2)\n"
+    "  synth DATASET --out DIR           a synthetic dataset: DATASET's sessions replayed with a model + noise\n"
     "  compare DATASET --out DIR         model versus measured frames: errors, heat maps, report\n"
     "  fit DATASET --out DIR             fit the model's parameters to a dataset (params.json)\n"
     "  diagnose DATASET --out DIR        find the effect(s) the model is missing\n"

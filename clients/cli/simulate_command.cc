@@ -12,28 +12,32 @@
 #include "calib/frame_csv.h"
 #include "calib/replay.h"
 #include "demo_session.h"
+#include "model_options.h"
 #include "progress.h"
 
 namespace hj::cli {
 
 namespace {
 
-constexpr const char* kSimulateUsage =
+const std::string kSimulateUsage = std::string(
     "usage: hapticjam simulate SESSION.json --out DIR [--mass KG] [--k N_PER_M]\n"
     "                          [--kappa-jam NM_PER_RAD] [--segments P] [--solver static|explicit]\n"
+    "                          [--params FILE] [--effects A,B] [--set NAME=VALUE]\n"
     "Replays the steps of a measurement session (docs/session-format.md; its frames\n"
     "need not exist) and writes the predicted frame of every capture to DIR under the\n"
     "same relative name, on the session's sample grid (CSV, mm).\n"
-    "  --mass KG            total membrane mass (default 0.55 kg per 12 cells)\n"
+    "  --mass KG            total membrane mass (default 0.55 kg per 12 cells; overrides --params)\n"
     "  --k N_PER_M          spring stiffness (default 64.5)\n"
     "  --kappa-jam NM_PER_RAD  jammed bending stiffness (default 4.79)\n"
     "  --segments P         segments per cell edge, >= 2 (default 4)\n"
-    "  --solver NAME        static (default, Newton) or explicit (the paper's Euler)\n";
+    "  --solver NAME        static (default, Newton) or explicit (the paper's Euler)\n") +
+                                   kModelOptionsUsage;
 
 struct SimulateArgs {
   std::string session;
   std::string out;
   std::optional<double> mass_kg, spring_k, kappa_jam;
+  ModelOptions model;
   int segments = 4;
   SolverKind solver = SolverKind::kStatic;
 };
@@ -49,6 +53,7 @@ SimulateArgs parse_simulate_args(const std::vector<std::string>& args, bool need
     else if (a == "--kappa-jam") out.kappa_jam = parse_number(a, value());
     else if (a == "--segments") out.segments = parse_int(a, value(), 2, 1000);
     else if (a == "--solver") out.solver = parse_solver_kind(value());
+    else if (out.model.parse(cursor)) continue;
     else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
     else if (need_session && out.session.empty()) out.session = a;
     else throw std::invalid_argument("unexpected argument \"" + a + "\"");
@@ -60,7 +65,8 @@ SimulateArgs parse_simulate_args(const std::vector<std::string>& args, bool need
 
 int simulate(const SimulateArgs& args) {
   const Session session = read_session(args.session);
-  SurfaceParameters params = SurfaceParameters::paper_defaults(session.device.geometry());
+  const ModelParams model = args.model.resolve(SurfaceParameters::paper_defaults(session.device.geometry()));
+  SurfaceParameters params = model.surface;
   if (args.mass_kg) params.mass_kg = *args.mass_kg;
   if (args.spring_k) params.spring_k = *args.spring_k;
   if (args.kappa_jam) params.kappa_jam = *args.kappa_jam;
@@ -68,6 +74,12 @@ int simulate(const SimulateArgs& args) {
   params.validate();
   SimulatorOptions options;
   options.solver = args.solver;
+  model.apply_to(options);
+  if (!model.effects.empty()) {
+    std::string on;
+    for (const auto& name : model.effects) on += (on.empty() ? "" : ", ") + name;
+    std::printf("effects on: %s\n", on.c_str());
+  }
 
   const auto start = std::chrono::steady_clock::now();
   ProgressLine progress("simulate " + session.name);
@@ -98,7 +110,7 @@ int simulate(const SimulateArgs& args) {
 
 int run_simulate(const std::vector<std::string>& args) {
   return run_subcommand<SimulateArgs>(
-      "simulate", kSimulateUsage, args, [](const std::vector<std::string>& a) { return parse_simulate_args(a, true); },
+      "simulate", kSimulateUsage.c_str(), args, [](const std::vector<std::string>& a) { return parse_simulate_args(a, true); },
       simulate);
 }
 

@@ -1,6 +1,7 @@
 // Replays a measurement session's steps in the simulator and predicts each
 // capture: the settled surface rasterised onto the session's sample grid
-// (docs/model.md, "Measured surfaces").
+// (docs/model.md, "Measured surfaces"), as changed by any measurement
+// effect (Effect::adjust_measurement, e.g. sensor_tilt).
 #pragma once
 
 #include <Eigen/Core>

@@ -48,6 +48,26 @@ class Effect {
   virtual std::optional<double> energy(const ForceContext& ctx, const Eigen::Matrix3Xd& x) const {
     return std::nullopt;
   }
+
+  // --- Optional hooks of the non-baseline effects (all no-ops by default) ---
+
+  // Largest stiffness (N/m) this effect adds at one point, for the explicit
+  // integrator's stable time step.
+  virtual double point_stiffness_bound(const Mesh& mesh, const SurfaceParameters& params) const { return 0.0; }
+  // True if the clamped edge is free to move under this effect's forces
+  // (it then supplies what holds the edge); pinned nodes stay fixed.
+  virtual bool frees_boundary() const { return false; }
+  // Called by Simulator after each settle to equilibrium: may change the
+  // state (e.g. a jam's rest angles creeping toward the current ones) and
+  // returns true if it did, so that the simulator settles once more.
+  virtual bool after_settle(const Mesh& mesh, const SurfaceParameters& params, DeviceState& state) const {
+    return false;
+  }
+  // Measurement effects: changes the heights (ny x nx, mm, NaN = unseen) a
+  // camera would report for a predicted surface sampled at x_mm (nx) by
+  // y_mm (ny) in the device frame. Physical effects leave them alone.
+  virtual void adjust_measurement(const Mesh& mesh, const Eigen::VectorXd& x_mm, const Eigen::VectorXd& y_mm,
+                                  Eigen::MatrixXd& heights_mm) const {}
 };
 
 }  // namespace hj

@@ -23,8 +23,8 @@ double explicit_time_step(const ForceModel& model, const ExplicitEulerOptions& o
   const SurfaceParameters& p = model.params();
   const double m = p.point_mass(model.mesh()), h = model.mesh().spacing();
   // Largest lattice stiffness per point: 8 k from springs; a jammed bending
-  // spring adds about 16 kappa / h^2 per direction.
-  const double stiffness = 8.0 * p.spring_k + 32.0 * p.kappa_jam / (h * h);
+  // spring adds about 16 kappa / h^2 per direction; effects add their bounds.
+  const double stiffness = 8.0 * p.spring_k + 32.0 * p.kappa_jam / (h * h) + model.extra_point_stiffness();
   const double omega_max = std::sqrt(stiffness / m);
   const double damping_rate = 8.0 * p.damping_b / m + options.drag_rate_per_s;
   return 0.3 * std::min(2.0 / omega_max, 2.0 / damping_rate);
@@ -34,7 +34,7 @@ SettleReport settle_explicit(const ForceModel& model, DeviceState& state, const 
   options.validate();
   const auto start = std::chrono::steady_clock::now();
   const Mesh& mesh = model.mesh();
-  const std::vector<char> fixed = state.fixed_points(mesh);
+  const std::vector<char> fixed = model.fixed_points(state);
   int free_count = 0;
   for (char c : fixed) free_count += !c;
   const double m = model.params().point_mass(mesh);

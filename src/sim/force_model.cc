@@ -1,5 +1,7 @@
 #include "sim/force_model.h"
 
+#include <algorithm>
+
 namespace hj {
 
 ForceModel::ForceModel(const Mesh& mesh, const SurfaceParameters& params,
@@ -31,6 +33,33 @@ double ForceModel::conservative_energy(const DeviceState& state, const Eigen::Ma
   for (const auto& effect : effects_)
     if (auto ei = effect->energy(ctx, x)) e += *ei;
   return e;
+}
+
+std::vector<char> ForceModel::fixed_points(const DeviceState& state) const {
+  std::vector<char> fixed = state.fixed_points(mesh_);
+  const bool edge_free =
+      std::any_of(effects_.begin(), effects_.end(), [](const auto& e) { return e->frees_boundary(); });
+  if (!edge_free) return fixed;
+  for (int p = 0; p < mesh_.num_points(); ++p)
+    if (mesh_.is_boundary(p)) fixed[p] = 0;
+  return fixed;
+}
+
+double ForceModel::extra_point_stiffness() const {
+  double k = 0.0;
+  for (const auto& effect : effects_) k += effect->point_stiffness_bound(mesh_, params_);
+  return k;
+}
+
+bool ForceModel::after_settle(DeviceState& state) const {
+  bool changed = false;
+  for (const auto& effect : effects_) changed |= effect->after_settle(mesh_, params_, state);
+  return changed;
+}
+
+void ForceModel::adjust_measurement(const Eigen::VectorXd& x_mm, const Eigen::VectorXd& y_mm,
+                                    Eigen::MatrixXd& heights_mm) const {
+  for (const auto& effect : effects_) effect->adjust_measurement(mesh_, x_mm, y_mm, heights_mm);
 }
 
 double max_free_force(const Eigen::Matrix3Xd& f, const std::vector<char>& fixed) {

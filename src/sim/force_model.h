@@ -28,6 +28,16 @@ class ForceModel {
   // Sum of the conservative effects' energies (J), ignoring the others.
   double conservative_energy(const DeviceState& state, const Eigen::Matrix3Xd& x) const;
 
+  // Points that do not move: the clamped edge (unless an effect frees it,
+  // Effect::frees_boundary) and the pinned nodes.
+  std::vector<char> fixed_points(const DeviceState& state) const;
+  // Sum of the effects' Effect::point_stiffness_bound (N/m).
+  double extra_point_stiffness() const;
+  // Runs every effect's Effect::after_settle; true if any changed the state.
+  bool after_settle(DeviceState& state) const;
+  // Applies every effect's Effect::adjust_measurement, in order.
+  void adjust_measurement(const Eigen::VectorXd& x_mm, const Eigen::VectorXd& y_mm, Eigen::MatrixXd& heights_mm) const;
+
  private:
   Mesh mesh_;
   SurfaceParameters params_;

@@ -23,6 +23,19 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
 }
 
 void Simulator::settle() {
+  settle_once();
+  // Effects that change the state at equilibrium (jam creep) do so once per
+  // settle; the surface then settles to the changed state.
+  if (last_.converged && model_.after_settle(state_)) {
+    const SettleReport first = last_;
+    settle_once();
+    last_.iterations += first.iterations;
+    last_.seconds += first.seconds;
+    last_.restarts += first.restarts;
+  }
+}
+
+void Simulator::settle_once() {
   if (options_.solver == SolverKind::kExplicit) {
     last_ = settle_explicit(model_, state_, options_.explicit_options);
     return;
@@ -79,7 +92,7 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
   }
   if (start) {
     const Eigen::Matrix3Xd cold = state_.x;
-    const std::vector<char> fixed = state_.fixed_points(m);
+    const std::vector<char> fixed = model_.fixed_points(state_);
     for (int p = 0; p < m.num_points(); ++p)
       if (!fixed[p]) state_.x.col(p) = start->col(p);
     settle();

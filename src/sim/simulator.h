@@ -54,7 +54,10 @@ class Simulator {
   const SettleReport& apply(const Action& action, const Eigen::Matrix3Xd& start);
 
  private:
+  // Settles, then runs the effects' after_settle hooks (ForceModel) and,
+  // if they changed the state, settles once more.
   void settle();
+  void settle_once();
   const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
   SimulatorOptions options_;

@@ -174,7 +174,7 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
   options.validate();
   const auto start = Clock::now();
   const Mesh& mesh = model.mesh();
-  const std::vector<char> fixed = state.fixed_points(mesh);
+  const std::vector<char> fixed = model.fixed_points(state);
   StiffnessMatrix k(mesh, fixed, [&](StiffnessSink& sink) { model.add_stiffness(state, state.x, sink); });
   SettleReport report;
   if (k.num_dofs() == 0) {

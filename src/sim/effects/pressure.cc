@@ -4,7 +4,7 @@
 // A follower load: not the gradient of an energy, so its stiffness is not
 // symmetric.
 #include "sim/effect_registry.h"
-#include "sim/normal.h"
+#include "sim/normal_load.h"
 
 namespace hj {
 namespace {
@@ -14,24 +14,11 @@ class Pressure final : public Effect {
   std::string_view name() const override { return "pressure"; }
 
   void add_forces(const ForceContext& ctx, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& f) const override {
-    const double load = ctx.state.pressure_pa * ctx.mesh.area_per_point();
-    if (load == 0.0) return;
-    for_each_inner_point(ctx.mesh, [&](int p, const NormalStencil& s) {
-      f.col(p) += load * s.normal(x);
-    });
+    add_normal_load(ctx.mesh, x, ctx.state.pressure_pa * ctx.mesh.area_per_point(), f);
   }
 
   void add_stiffness(const ForceContext& ctx, const Eigen::Matrix3Xd& x, StiffnessSink& sink) const override {
-    const double load = ctx.state.pressure_pa * ctx.mesh.area_per_point();
-    if (load == 0.0) return;
-    for_each_inner_point(ctx.mesh, [&](int p, const NormalStencil& s) {
-      const NormalJacobian dn = s.normal_jacobian(x);
-      // K = -dF/dx.
-      sink.add(p, s.right, -load * dn.d_right);
-      sink.add(p, s.left, load * dn.d_right);
-      sink.add(p, s.up, -load * dn.d_up);
-      sink.add(p, s.down, load * dn.d_up);
-    });
+    add_normal_load_stiffness(ctx.mesh, x, ctx.state.pressure_pa * ctx.mesh.area_per_point(), sink);
   }
 };
 

@@ -4,22 +4,10 @@
 #include <cmath>
 
 #include "sim/effect_registry.h"
+#include "sim/lattice_springs.h"
 
 namespace hj {
 namespace {
-
-// Calls fn(i_point, j_point) for every spring with at least one free end.
-template <class Fn>
-void for_each_spring(const Mesh& mesh, Fn&& fn) {
-  const int nr = mesh.point_rows(), nc = mesh.point_cols();
-  for (int i = 0; i < nr; ++i) {
-    for (int j = 0; j < nc; ++j) {
-      const int a = mesh.index(i, j);
-      if (j + 1 < nc && !(mesh.is_boundary(a) && mesh.is_boundary(a + 1))) fn(a, a + 1);
-      if (i + 1 < nr && !(mesh.is_boundary(a) && mesh.is_boundary(a + nc))) fn(a, a + nc);
-    }
-  }
-}
 
 class Springs final : public Effect {
  public:
@@ -28,27 +16,15 @@ class Springs final : public Effect {
   void add_forces(const ForceContext& ctx, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& f) const override {
     const double k = ctx.params.spring_k, h = ctx.mesh.spacing();
     for_each_spring(ctx.mesh, [&](int a, int b) {
-      const Eigen::Vector3d d = x.col(b) - x.col(a);
-      const double len = d.norm();
-      const Eigen::Vector3d fa = (k * (len - h) / len) * d;
-      f.col(a) += fa;
-      f.col(b) -= fa;
+      add_tension_force(a, b, x, k * ((x.col(b) - x.col(a)).norm() - h), f);
     });
   }
 
   void add_stiffness(const ForceContext& ctx, const Eigen::Matrix3Xd& x, StiffnessSink& sink) const override {
     const double k = ctx.params.spring_k, h = ctx.mesh.spacing();
+    // May be indefinite when a spring is compressed.
     for_each_spring(ctx.mesh, [&](int a, int b) {
-      const Eigen::Vector3d d = x.col(b) - x.col(a);
-      const double len = d.norm();
-      const Eigen::Vector3d u = d / len;
-      const Eigen::Matrix3d uu = u * u.transpose();
-      // dF_a/dx_b; may be indefinite when the spring is compressed.
-      const Eigen::Matrix3d ks = k * (uu + (1.0 - h / len) * (Eigen::Matrix3d::Identity() - uu));
-      sink.add(a, a, ks);
-      sink.add(b, b, ks);
-      sink.add(a, b, -ks);
-      sink.add(b, a, -ks);
+      add_tension_stiffness(a, b, x, k * ((x.col(b) - x.col(a)).norm() - h), k, sink);
     });
   }
 
