@@ -87,4 +87,20 @@ Dataset select_sessions(const Dataset& dataset, const std::vector<std::string>& 
   return out;
 }
 
+Dataset sessions_up_to(const Dataset& dataset, const std::function<bool(const MeasuredCapture&)>& chosen) {
+  Dataset out;
+  out.dir = dataset.dir;
+  for (const auto& s : dataset.sessions) {
+    int last = -1;
+    for (size_t c = 0; c < s.captures.size(); ++c)
+      if (chosen(s.captures[c])) last = static_cast<int>(c);
+    if (last < 0) continue;
+    MeasuredSession head = s;
+    head.captures.resize(last + 1);
+    head.session.steps.resize(head.captures.back().step_index + 1);
+    out.sessions.push_back(std::move(head));
+  }
+  return out;
+}
+
 }  // namespace hj

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,5 +48,10 @@ Dataset read_dataset(const std::filesystem::path& dir);
 // The sessions of `dataset` named in `names` (keep = true) or all others
 // (keep = false). @throws SessionError naming an unknown session.
 Dataset select_sessions(const Dataset& dataset, const std::vector<std::string>& names, bool keep);
+
+// Each session that has a capture matching `chosen`, cut after the last
+// such capture (steps and captures): what a fit of those captures needs to
+// replay. Captures before it that do not match stay.
+Dataset sessions_up_to(const Dataset& dataset, const std::function<bool(const MeasuredCapture&)>& chosen);
 
 }  // namespace hj

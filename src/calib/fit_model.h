@@ -1,8 +1,9 @@
 // A full fit of a model to a dataset, the paper's way then jointly: the mass
-// from the levelling pressure (levelling.h), the spring and jammed bending
-// stiffnesses by Algorithm 1 (stiffness_bisection.h), then every parameter
-// of the baseline and the switched-on effects by bounded least squares
-// (least_squares.h) from there.
+// from the levelling pressure (levelling.h), the spring stiffness by
+// Algorithm 1 (stiffness_bisection.h), mass and spring stiffness refined on
+// the bare captures, the jammed bending stiffness by Algorithm 1, then every
+// parameter of the baseline and the switched-on effects by bounded least
+// squares (least_squares.h) from there.
 #pragma once
 
 #include <functional>
@@ -30,7 +31,8 @@ struct FitReport {
   ModelParams start;
   LevellingEstimate levelling;
   std::vector<StiffnessEstimate> stiffnesses;
-  ModelParams initial;  // after levelling and Algorithm 1
+  ModelParams initial;  // after levelling, Algorithm 1 and the refit on the bare captures
+  double bare_rmse_mm = 0.0;  // of that refit (0 if not run)
   LeastSquaresResult joint;
 };
 

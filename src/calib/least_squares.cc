@@ -65,14 +65,34 @@ class ScaledModel {
       const double h = options_.difference_step;
       steps[j] = u[j] + h <= parameters_[j].spec.upper / scale_[j] ? h : -h;
     }
-    if (!run(p * sessions, [&](int job) {
-          const int j = job / sessions, s = job % sessions;
-          Eigen::VectorXd point = u;
-          point[j] += steps[j];
-          values.col(j).segment(rows_[s], rows_[s + 1] - rows_[s]) =
-              session_residuals(dataset_.sessions[s], params_at(point), options_.replay, &traces[s]);
-        }))
-      return false;
+    // A column whose step leaves the region where the model settles is
+    // taken by the opposite step.
+    std::vector<std::atomic<bool>> failed(p);
+    auto column = [&](int job) {
+      const int j = job / sessions, s = job % sessions;
+      Eigen::VectorXd point = u;
+      point[j] += steps[j];
+      try {
+        values.col(j).segment(rows_[s], rows_[s + 1] - rows_[s]) =
+            session_residuals(dataset_.sessions[s], params_at(point), options_.replay, &traces[s]);
+      } catch (const std::exception&) {
+        failed[j] = true;
+      }
+    };
+    run(p * sessions, column);
+    std::vector<int> retry;
+    for (int j = 0; j < p; ++j)
+      if (failed[j]) {
+        failed[j] = false;
+        steps[j] = -steps[j];
+        retry.push_back(j);
+      }
+    if (!retry.empty()) {
+      run(static_cast<int>(retry.size()) * sessions,
+          [&](int job) { column(retry[job / sessions] * sessions + job % sessions); });
+      for (int j : retry)
+        if (failed[j]) return false;
+    }
     jacobian->resize(residual_count_all(), p);
     for (int j = 0; j < p; ++j) jacobian->col(j) = (values.col(j) - r) / steps[j];
     seed(u, r, *jacobian);

@@ -19,7 +19,7 @@ namespace hj {
 struct LeastSquaresOptions {
   int max_iterations = 20;
   double function_tolerance = 1e-6;  // relative change of the cost that ends the fit
-  double difference_step = 1e-3;     // forward-difference step, relative to each parameter's scale
+  double difference_step = 3e-3;     // forward-difference step, relative to each parameter's scale
   // A parameter whose 95 % half-width exceeds this share of its value is
   // reported as only loosely constrained by the data.
   double loose_relative_halfwidth = 0.1;

@@ -19,6 +19,40 @@ double centre_height_mm(const Session& session, const MeasuredCapture& capture) 
   return n ? sum / n : std::nan("");
 }
 
+namespace {
+
+// A net without pre-tension deflects as the cube root of its net load:
+// h = a cbrt(P - P0). Over the session's unjammed, unpinned captures, P0 in
+// [lo, hi] minimising the squared misfit (a in closed form for each P0).
+double cube_root_crossing(const Session& session, const std::vector<MeasuredCapture>& captures, double lo, double hi) {
+  std::vector<std::pair<double, double>> points;  // (P, h)
+  for (const auto& c : captures) {
+    if (c.jammed_count() > 0 || !c.pinned.empty()) continue;
+    const double h = centre_height_mm(session, c);
+    if (!std::isnan(h)) points.push_back({c.pressure_pa, h});
+  }
+  auto misfit = [&](double p0) {
+    double sxy = 0.0, sxx = 0.0, syy = 0.0;
+    for (auto [p, h] : points) {
+      const double x = std::cbrt(p - p0);
+      sxy += x * h;
+      sxx += x * x;
+      syy += h * h;
+    }
+    return sxx > 0.0 ? syy - sxy * sxy / sxx : syy;
+  };
+  double best = 0.5 * (lo + hi), best_misfit = misfit(best);
+  constexpr int kSteps = 2000;
+  for (int k = 0; k <= kSteps; ++k) {
+    const double p0 = lo + (hi - lo) * k / kSteps;
+    const double m = misfit(p0);
+    if (m < best_misfit) best_misfit = m, best = p0;
+  }
+  return best;
+}
+
+}  // namespace
+
 LevellingEstimate levelling_mass(const Dataset& dataset, double gravity) {
   LevellingEstimate out;
   for (const MeasuredSession& measured : dataset.sessions) {
@@ -33,9 +67,8 @@ LevellingEstimate levelling_mass(const Dataset& dataset, double gravity) {
       const double h = centre_height_mm(session, capture);
       if (std::isnan(h)) continue;
       if (previous && capture.pressure_pa > previous->pressure_pa && previous_h < 0.0 && h >= 0.0) {
-        const double a = std::pow(previous_h, 3), b = std::pow(h, 3);
         out.found = true;
-        out.pressure_pa = previous->pressure_pa + (capture.pressure_pa - previous->pressure_pa) * (-a) / (b - a);
+        out.pressure_pa = cube_root_crossing(session, measured.captures, previous->pressure_pa, capture.pressure_pa);
         const double area_m2 = session.device.rows * session.device.cols * std::pow(session.device.cell_size_mm / 1000.0, 2);
         out.mass_kg = out.pressure_pa * area_m2 / gravity;
         out.session = session.name;

@@ -24,9 +24,10 @@ struct LevellingEstimate {
 double centre_height_mm(const Session& session, const MeasuredCapture& capture);
 
 // The first sign change of the centre height between two consecutive
-// unjammed, unpinned captures of a session at rising pressure. A net
-// without pre-tension deflects as the cube root of its net load, so h^3 is
-// interpolated linearly in P. found = false if no session has a crossing.
+// unjammed, unpinned captures of a session at rising pressure, located by
+// fitting the law of a net without pre-tension, whose centre deflects as the
+// cube root of its net load, h = a cbrt(P - P0), to that session's unjammed,
+// unpinned captures. found = false if no session has a crossing.
 LevellingEstimate levelling_mass(const Dataset& dataset, double gravity);
 
 }  // namespace hj

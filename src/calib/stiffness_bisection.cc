@@ -42,22 +42,9 @@ BisectionResult fit_stiffness_by_bisection(const Dataset& dataset, const ModelPa
   out.value = parameter_value(start, parameter);
   // Only the sessions with a chosen capture need replaying, each up to its
   // last chosen capture.
-  Dataset used;
-  used.dir = dataset.dir;
-  for (const auto& s : dataset.sessions) {
-    int chosen = 0, last = -1;
-    for (size_t c = 0; c < s.captures.size(); ++c)
-      if (filter(s.captures[c])) {
-        ++chosen;
-        last = static_cast<int>(c);
-      }
-    out.captures += chosen;
-    if (last < 0) continue;
-    MeasuredSession head = s;
-    head.captures.resize(last + 1);
-    head.session.steps.resize(head.captures.back().step_index + 1);
-    used.sessions.push_back(std::move(head));
-  }
+  const Dataset used = sessions_up_to(dataset, filter);
+  for (const auto& s : dataset.sessions)
+    for (const auto& c : s.captures) out.captures += filter(c) ? 1 : 0;
   if (used.sessions.empty() || out.value <= 0.0) return out;
   constexpr int kMaxGrowth = 4;
   const int total = 2 + 2 * kMaxGrowth + options.iterations;
