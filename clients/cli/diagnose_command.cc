@@ -53,7 +53,7 @@ int diagnose_dataset(const CalibArgs& args) {
   DiagnoseOptions options;
   options.candidates = args.effects;
   options.fit.least_squares.max_iterations = args.max_iterations;
-  options.fit.least_squares.replay = replay_options(args);
+  options.fit.least_squares.replay = fitting_replay(replay_options(args));
   options.fit.bisection.replay = options.fit.least_squares.replay;
   StageProgress progress;
   const Diagnosis d = diagnose(dataset, start_model, options, std::ref(progress));

@@ -42,7 +42,7 @@ int fit(const CalibArgs& args) {
   FitOptions options;
   options.initial_estimates = args.initial_estimates;
   options.least_squares.max_iterations = args.max_iterations;
-  options.least_squares.replay = replay_options(args);
+  options.least_squares.replay = fitting_replay(replay_options(args));
   options.bisection.replay = options.least_squares.replay;
   StageProgress progress;
   const FitReport report = fit_model(train, start_model, start_model.effects, options, std::ref(progress));

@@ -23,7 +23,7 @@ struct LeastSquaresOptions {
   // A parameter whose 95 % half-width exceeds this share of its value is
   // reported as only loosely constrained by the data.
   double loose_relative_halfwidth = 0.1;
-  ReplayOptions replay;
+  ReplayOptions replay = fitting_replay({});
 };
 
 struct ParameterEstimate {

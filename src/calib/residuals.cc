@@ -74,9 +74,15 @@ Eigen::MatrixXd Evaluation::cell_rmse_mm() const {
   return out;
 }
 
+ReplayOptions fitting_replay(ReplayOptions options) {
+  options.fallback_max_steps = std::min(options.fallback_max_steps, 20'000L);
+  return options;
+}
+
 SimulatorOptions simulator_options(const ModelParams& params, const ReplayOptions& options) {
   SimulatorOptions out;
   out.static_options = options.solver;
+  out.fallback_max_steps = options.fallback_max_steps;
   params.apply_to(out);
   return out;
 }

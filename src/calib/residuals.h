@@ -19,7 +19,14 @@ struct ReplayOptions {
   int segments = 4;  // p, mesh segments per cell edge
   StaticSolverOptions solver;
   int threads = 0;   // 0: one per core
+  // Explicit steps a failed static settle may fall back to. A fit probes
+  // parameters where the model has no equilibrium (the net creases just
+  // below levelling), and must learn that quickly; see fitting_replay().
+  long fallback_max_steps = 2'000'000;
 };
+
+// The options of fits: a short explicit fallback.
+ReplayOptions fitting_replay(ReplayOptions options);
 
 // The error of one capture, residual = predicted - measured.
 struct CaptureError {

@@ -20,7 +20,7 @@ using CaptureFilter = std::function<bool(const MeasuredCapture&)>;
 
 struct BisectionOptions {
   int iterations = 12;  // halvings of the log bracket
-  ReplayOptions replay;
+  ReplayOptions replay = fitting_replay({});
 };
 
 struct BisectionResult {
