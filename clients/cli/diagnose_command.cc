@@ -81,11 +81,13 @@ int diagnose_dataset(const CalibArgs& args) {
       {"verdict", d.verdict},
       {"worst_cells", worst},
       {"findings", d.pattern.findings},
+      {"skipped", d.skipped},
       {"ladder", ladder},
       {"noise_floor_mm", d.noise_floor_mm},
       {"final_params", model_params_json(d.final_params)},
       {"seconds", seconds},
-      {"cpu_seconds", cpu_seconds}};
+      {"cpu_seconds", cpu_seconds},
+      {"timing", progress.timing()}};
   const std::filesystem::path out(args.out);
   write_json(out / "diagnosis.json", doc);
   write_model_params(out / "params.json", d.final_params, {{"verdict", d.verdict}});
@@ -154,6 +156,9 @@ int diagnose_dataset(const CalibArgs& args) {
     std::printf("  %-20s RMSE %.3f  held out %.3f  dBIC %10.1f %s\n", c.added.c_str(), c.fit.rmse_mm,
                 c.heldout_rmse_mm, c.delta_bic, c.significant ? "significant" : "");
   for (const auto& f : d.pattern.findings) std::printf("%s\n", f.c_str());
+  for (const auto& t : progress.timing())
+    std::printf("  time in %-40s %7.1f s wall %7.1f s CPU\n", t["stage"].get<std::string>().c_str(),
+                t["wall_s"].get<double>(), t["cpu_s"].get<double>());
   std::printf("%s\nwrote %s in %.1f s (CPU %.1f s)\n", verdict_text.c_str(), (out / "diagnosis.json").c_str(), seconds,
               cpu_seconds);
   return 0;

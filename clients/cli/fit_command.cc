@@ -87,7 +87,8 @@ int fit(const CalibArgs& args) {
                                                    {"termination", joint.termination}}},
                                 {"dataset", all.dir.string()},
                                 {"seconds", seconds},
-                                {"cpu_seconds", cpu_seconds}};
+                                {"cpu_seconds", cpu_seconds},
+                                {"timing", progress.timing()}};
   const std::filesystem::path out(args.out);
   write_model_params(out / "params.json", joint.params, extra);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace hj {
 
@@ -38,7 +39,8 @@ double bic(const LeastSquaresResult& fit) {
 
 double noise_floor_mm(const Dataset& dataset) {
   const Session& s = dataset.sessions.front().session;
-  return std::sqrt(s.sensor_accuracy_mm * s.sensor_accuracy_mm + s.sensor_resolution_mm * s.sensor_resolution_mm / 12.0);
+  return std::sqrt(s.sensor_accuracy_mm * s.sensor_accuracy_mm +
+                   s.sensor_resolution_mm * s.sensor_resolution_mm / 12.0);
 }
 
 Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const DiagnoseOptions& options,
@@ -53,7 +55,9 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   base_start.effect_parameters.clear();
   out.baseline = fit_model(dataset, base_start, {}, options.fit, progress);
   const auto base_parameters = fit_parameters({});
+  if (progress) progress("cross-validation", 0, 1, "baseline");
   out.baseline_heldout_rmse_mm = cross_validate(dataset, base_parameters, out.baseline.joint, replay).heldout_rmse_mm;
+  if (progress) progress("cross-validation", 1, 1, "baseline");
   out.ladder.push_back({"baseline", out.baseline.joint.rmse_mm, out.baseline_heldout_rmse_mm});
   if (progress) progress("residual pattern", 0, 1, "");
   out.pattern = describe_residuals(dataset, evaluate_dataset(dataset, out.baseline.joint.params, replay));
@@ -67,29 +71,37 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   std::vector<std::string> remaining = candidate_effects(options);
   for (int round = 0; round < options.max_effects && !remaining.empty(); ++round) {
     std::vector<CandidateFit> fits;
-    int done = 0;
-    const std::string stage = round == 0 ? "candidates" : "candidates on + " + chosen.back();
+    std::string on;
+    for (const auto& e : chosen) on += " + " + e;
     for (const auto& effect : remaining) {
-      if (progress) progress(stage, done, static_cast<int>(remaining.size()), effect);
+      // One progress stage per candidate, so that its time shows apart.
+      const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
       CandidateFit c;
       c.effects = chosen;
       c.effects.push_back(effect);
       c.added = effect;
       const auto parameters = fit_parameters(c.effects);
-      // Warm start: the current model's optimum, the new effect at its defaults.
-      c.fit = fit_least_squares(dataset, with_effects(current.params, c.effects), parameters, options.fit.least_squares,
-                                [&](int iteration, int max_iterations, double rmse) {
-                                  if (progress)
-                                    progress(stage, done, static_cast<int>(remaining.size()),
-                                             effect + " iteration " + std::to_string(iteration));
-                                });
-      c.heldout_rmse_mm = cross_validate(dataset, parameters, c.fit, replay).heldout_rmse_mm;
-      c.delta_bic = bic(c.fit) - bic(current);
-      c.significant = is_significant(c, current_heldout, options);
+      // Warm start: the current model's optimum, the new effect at its
+      // defaults. A candidate the model cannot replay is skipped and said so.
+      try {
+        c.fit = fit_least_squares(dataset, with_effects(current.params, c.effects), parameters,
+                                  options.fit.least_squares, [&](int iteration, int max_iterations, double rmse) {
+                                    char detail[64];
+                                    std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
+                                    if (progress) progress(stage, iteration, max_iterations, detail);
+                                  });
+        c.heldout_rmse_mm = cross_validate(dataset, parameters, c.fit, replay).heldout_rmse_mm;
+        c.delta_bic = bic(c.fit) - bic(current);
+        c.significant = is_significant(c, current_heldout, options);
+      } catch (const std::exception& e) {
+        out.skipped.push_back(effect + ": " + e.what());
+        continue;
+      }
+      if (progress)
+        progress(stage, options.fit.least_squares.max_iterations, options.fit.least_squares.max_iterations,
+                 "held out " + std::to_string(c.heldout_rmse_mm) + " mm");
       fits.push_back(std::move(c));
-      ++done;
     }
-    if (progress) progress(stage, done, static_cast<int>(remaining.size()), "");
     std::stable_sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
       if (a.significant != b.significant) return a.significant;
       return a.heldout_rmse_mm < b.heldout_rmse_mm;

@@ -48,6 +48,7 @@ struct Diagnosis {
   ModelParams final_params;
   std::vector<LadderStep> ladder;
   ResidualPattern pattern;            // of the baseline at its optimum
+  std::vector<std::string> skipped;   // candidates that failed to fit, with why
   double noise_floor_mm = 0.0;
 };
 
