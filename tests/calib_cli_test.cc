@@ -44,6 +44,7 @@ nlohmann::json read_json(const fs::path& p) { return nlohmann::json::parse(read_
 // A dataset of two cheap sessions (no jammed sweep).
 fs::path small_dataset(const fs::path& dir) {
   const fs::path out = dir / "dataset";
+  fs::create_directories(out);
   for (const char* name : {"unjammed-sweep", "mixed-1"})
     fs::copy(kBaseline / name, out / name, fs::copy_options::recursive);
   return out;

@@ -36,7 +36,7 @@ double fitted(const ModelParams& p, const std::string& effect, const std::string
 TEST(Diagnose, FindsTheBendingStiffnessInDemoBending) {
   const Dataset d = cheap("demo-bending");
   const Diagnosis result = diagnose(d, ModelParams{}, quick_options());
-  ASSERT_EQ(result.ranking.size(), 2u);
+  ASSERT_EQ(result.ranking.size(), 2u) << ::testing::PrintToString(result.skipped);
   EXPECT_EQ(result.ranking[0].added, "bending");
   EXPECT_TRUE(result.ranking[0].significant);
   ASSERT_EQ(result.verdict, std::vector<std::string>{"bending"});
@@ -55,6 +55,7 @@ TEST(Diagnose, FindsTheBendingStiffnessInDemoBending) {
 TEST(Diagnose, ChoosesNothingOnDemoBaseline) {
   const Dataset d = cheap("demo-baseline");
   const Diagnosis result = diagnose(d, ModelParams{}, quick_options());
+  EXPECT_TRUE(result.skipped.empty()) << ::testing::PrintToString(result.skipped);
   EXPECT_TRUE(result.verdict.empty());
   for (const auto& c : result.ranking) {
     EXPECT_FALSE(c.significant) << c.added;

@@ -79,12 +79,12 @@ TEST(LeastSquares, RecoversTheTrueParametersWithHonestIntervals) {
   const auto& k = estimate(fit, "spring_k");
   EXPECT_NEAR(mass.value, kTrueMass, 0.03 * kTrueMass);
   EXPECT_NEAR(k.value, kTrueK, 0.03 * kTrueK);
-  // The truth lies inside the reported 95 % intervals, which are not absurdly wide.
-  EXPECT_LE(mass.ci95_low, kTrueMass);
-  EXPECT_GE(mass.ci95_high, kTrueMass);
-  EXPECT_LE(k.ci95_low, kTrueK);
-  EXPECT_GE(k.ci95_high, kTrueK);
-  EXPECT_LT(k.ci95_high - k.ci95_low, 0.2 * kTrueK);
+  // The truth lies within three standard errors (a 95 % interval, 1.96
+  // of them, misses it one time in twenty), and the intervals are tight.
+  EXPECT_NEAR(mass.value, kTrueMass, 3.0 * mass.std_error) << "std error " << mass.std_error;
+  EXPECT_NEAR(k.value, kTrueK, 3.0 * k.std_error) << "std error " << k.std_error;
+  EXPECT_NEAR(mass.ci95_high - mass.ci95_low, 2.0 * 1.96 * mass.std_error, 1e-12);
+  EXPECT_LT(k.ci95_high - k.ci95_low, 0.02 * kTrueK);
   // The damping acts only in dynamics: it changes no settled capture.
   EXPECT_FALSE(estimate(fit, "damping_b").active);
   // At the optimum, only the camera's noise is left (about 1.04 mm).
