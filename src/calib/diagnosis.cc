@@ -30,6 +30,31 @@ bool is_significant(const CandidateFit& c, double reference_heldout_mm, const Di
          c.delta_bic < options.max_delta_bic;
 }
 
+// The candidate starts from the current optimum with the added effect at
+// its registry defaults. The registry does not say where an effect is
+// neutral; where the model cannot replay the defaults (area_pressure's
+// default is the full effect, which moves the levelling pressure), the
+// effect's parameters start at their lower, then their upper bounds.
+LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& current,
+                                 const std::vector<std::string>& effects, const std::vector<FitParameter>& parameters,
+                                 const std::string& added, const DiagnoseOptions& options,
+                                 const LeastSquaresProgress& progress) {
+  const ModelParams start = with_effects(current, effects);
+  std::vector<ModelParams> starts = {start, start, start};
+  for (const auto& p : parameters)
+    if (!p.surface && p.effect == added) {
+      set_parameter_value(starts[1], p, p.spec.lower);
+      set_parameter_value(starts[2], p, p.spec.upper);
+    }
+  for (size_t k = 0;; ++k) {
+    try {
+      return fit_least_squares(dataset, starts[k], parameters, options.fit.least_squares, progress);
+    } catch (const std::exception&) {
+      if (k + 1 == starts.size()) throw;
+    }
+  }
+}
+
 }  // namespace
 
 double bic(const LeastSquaresResult& fit) {
@@ -84,12 +109,12 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
       // Warm start: the current model's optimum, the new effect at its
       // defaults. A candidate the model cannot replay is skipped and said so.
       try {
-        c.fit = fit_least_squares(dataset, with_effects(current.params, c.effects), parameters,
-                                  options.fit.least_squares, [&](int iteration, int max_iterations, double rmse) {
-                                    char detail[64];
-                                    std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
-                                    if (progress) progress(stage, iteration, max_iterations, detail);
-                                  });
+        c.fit = fit_candidate(dataset, current.params, c.effects, parameters, effect, options,
+                              [&](int iteration, int max_iterations, double rmse) {
+                                char detail[64];
+                                std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
+                                if (progress) progress(stage, iteration, max_iterations, detail);
+                              });
         c.heldout_rmse_mm = cross_validate(dataset, parameters, c.fit, replay).heldout_rmse_mm;
         c.delta_bic = bic(c.fit) - bic(current);
         c.significant = is_significant(c, current_heldout, options);
