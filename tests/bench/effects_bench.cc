@@ -27,10 +27,21 @@ hj::SimulatorOptions all_effects() {
   return o;
 }
 
-// args: 0 baseline, 1 all effects.
+hj::SimulatorOptions bending_only() {
+  hj::SimulatorOptions o;
+  o.extra_effects = {"bending"};
+  o.effect_parameters["bending"] = {{"kappa_bend", 0.002}};
+  return o;
+}
+
+// args: 0 baseline, 1 all effects, 2 the baseline and bending (the costliest: an
+// automatic-differentiation Hessian per bending spring, two at every interior
+// and border point).
 void BM_ForceAndStiffness(benchmark::State& state) {
   const hj::ArrayGeometry g{3, 4, 0.038, 4};
-  hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), state.range(0) ? all_effects() : hj::SimulatorOptions{});
+  hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), state.range(0) == 1   ? all_effects()
+                                                                     : state.range(0) == 2 ? bending_only()
+                                                                                           : hj::SimulatorOptions{});
   for (const Action& a : {Action::set_pressure(2000.0), Action::jam(0, 0), Action::jam(1, 1), Action::jam(2, 2)})
     sim.apply(a);
   const hj::ForceModel& model = sim.model();
@@ -47,6 +58,6 @@ void BM_ForceAndStiffness(benchmark::State& state) {
   state.counters["nonzeros"] = static_cast<double>(k.matrix().nonZeros());
 }
 
-BENCHMARK(BM_ForceAndStiffness)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ForceAndStiffness)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
