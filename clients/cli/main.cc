@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "compare_command.h"
+#include "diagnose_command.h"
+#include "fit_command.h"
 #include "plan_command.h"
 #include "remote_command.h"
 #include "simulate_command.h"
@@ -27,6 +30,9 @@ const std::vector<Command> kCommands = {
     {"synth", hj::cli::run_synth},
     {"remote", hj::cli::run_remote},
     {"sweep", hj::cli::run_sweep_command},
+    {"compare", hj::cli::run_compare},
+    {"fit", hj::cli::run_fit},
+    {"diagnose", hj::cli::run_diagnose},
 };
 
 constexpr const char* kUsage =
@@ -39,6 +45,9 @@ constexpr const char* kUsage =
     "  remote SUBCOMMAND --server HOST:PORT    a client of hapticjam-server (plan, preview,\n"
     "                                    submit, watch, cancel, status, stop, resume ...)\n"
     "  sweep GOAL... --out DIR           every goal at every array size, Figs. 11/13, Table 2\n"
+    "  compare DATASET --out DIR         model versus measured frames: errors, heat maps, report\n"
+    "  fit DATASET --out DIR             fit the model's parameters to a dataset (params.json)\n"
+    "  diagnose DATASET --out DIR        find the effect(s) the model is missing\n"
     "run 'hapticjam COMMAND --help' for a command's options\n";
 
 }  // namespace

@@ -30,6 +30,12 @@ double number(const nlohmann::json& v, const std::string& origin, const std::str
 
 }  // namespace
 
+double* surface_field(SurfaceParameters& surface, const std::string& name) {
+  for (const auto& f : kSurfaceFields)
+    if (name == f.name) return &(surface.*(f.member));
+  return nullptr;
+}
+
 void ModelParams::apply_to(SimulatorOptions& options) const {
   options.extra_effects = effects;
   options.effect_parameters = effect_parameters;

@@ -39,6 +39,10 @@ struct ModelParams {
   void apply_to(SimulatorOptions& options) const;
 };
 
+// The SurfaceParameters field named `name` (mass_kg, spring_k, damping_b,
+// kappa_jam, gravity, max_pressure_pa), or nullptr for another name.
+double* surface_field(SurfaceParameters& surface, const std::string& name);
+
 // Parses a params document; `defaults` supplies the surface fields it omits.
 // @throws ParamsError naming `origin` (a file name) and the key that is
 //         wrong: not an object, an unknown surface field or effect, a value

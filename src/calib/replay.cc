@@ -5,7 +5,8 @@
 namespace hj {
 
 std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,
-                                             const SimulatorOptions& options, const ReplayProgress& progress) {
+                                             const SimulatorOptions& options, const ReplayProgress& progress,
+                                             const ReplayTrace* warm_start, ReplayTrace* trace) {
   params.max_pressure_pa = session.device.max_pressure_kpa * 1000.0;
   Simulator sim(session.device.geometry(segments), params, options);
   const Eigen::VectorXd x_mm = Eigen::VectorXd::LinSpaced(session.grid.nx, 0, session.grid.nx - 1) * session.grid.dx_mm +
@@ -14,6 +15,10 @@ std::vector<PredictedCapture> replay_session(const Session& session, int segment
                                Eigen::VectorXd::Constant(session.grid.ny, session.grid.y0_mm);
   std::vector<PredictedCapture> captures;
   const int total = static_cast<int>(session.steps.size());
+  if (warm_start && static_cast<int>(warm_start->size()) != total)
+    throw std::invalid_argument("replay_session: the warm start has " + std::to_string(warm_start->size()) +
+                                " steps, " + session.name + " " + std::to_string(total));
+  if (trace) trace->assign(total, Eigen::Matrix3Xd());
   for (int i = 0; i < total; ++i) {
     const SessionStep& step = session.steps[i];
     if (step.kind == SessionStep::Kind::kCapture) {
@@ -23,7 +28,10 @@ std::vector<PredictedCapture> replay_session(const Session& session, int segment
       captures.push_back({step.index, step.frame, step.label, std::move(heights)});
     } else {
       try {
-        sim.apply(step.action);
+        const Eigen::Matrix3Xd* start = warm_start ? &(*warm_start)[i] : nullptr;
+        if (start && start->cols() == sim.state().x.cols()) sim.apply(step.action, *start);
+        else sim.apply(step.action);
+        if (trace) (*trace)[i] = sim.state().x;
       } catch (const std::exception& e) {
         throw SessionError(session.name + ": steps[" + std::to_string(step.index) + "] (" + step.action.op_name() +
                            "): " + e.what());

@@ -24,9 +24,15 @@ struct PredictedCapture {
 // Called after each step: steps done, steps in all, and the step's report.
 using ReplayProgress = std::function<void(int done, int total, const SessionStep& step, const SettleReport& settle)>;
 
+// The settled positions (3 x N, m) after each step of a replay, by step
+// (empty for a capture): recorded by one replay, they warm-start another of
+// the same session under nearby parameters (Simulator::apply with a start).
+using ReplayTrace = std::vector<Eigen::Matrix3Xd>;
+
 // The session's device with `params` (whose max pressure is replaced by the
 // session's). Throws SessionError naming the step when an action fails.
 std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,
-                                             const SimulatorOptions& options, const ReplayProgress& progress = {});
+                                             const SimulatorOptions& options, const ReplayProgress& progress = {},
+                                             const ReplayTrace* warm_start = nullptr, ReplayTrace* trace = nullptr);
 
 }  // namespace hj

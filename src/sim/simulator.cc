@@ -54,7 +54,16 @@ void Simulator::settle_once() {
   last_.seconds += dynamic.seconds;
 }
 
-const SettleReport& Simulator::apply(const Action& action) {
+const SettleReport& Simulator::apply(const Action& action) { return apply_from(action, nullptr); }
+
+const SettleReport& Simulator::apply(const Action& action, const Eigen::Matrix3Xd& start) {
+  if (start.cols() != state_.x.cols())
+    throw std::invalid_argument("Simulator::apply: start has " + std::to_string(start.cols()) + " points, the mesh " +
+                                std::to_string(state_.x.cols()));
+  return apply_from(action, &start);
+}
+
+const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Matrix3Xd* start) {
   action.validate(mesh(), params());
   const DeviceState before = state_;
   const Mesh& m = mesh();
@@ -83,7 +92,15 @@ const SettleReport& Simulator::apply(const Action& action) {
       break;
   }
   try {
-    settle();
+    if (start) {
+      const Eigen::Matrix3Xd cold = state_.x;
+      const std::vector<char> fixed = model_.fixed_points(state_);
+      for (int p = 0; p < m.num_points(); ++p)
+        if (!fixed[p]) state_.x.col(p) = start->col(p);
+      settle();
+      if (!last_.converged) state_.x = cold;
+    }
+    if (!start || !last_.converged) settle();
   } catch (...) {
     state_ = before;
     throw;

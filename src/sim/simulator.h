@@ -52,12 +52,18 @@ class Simulator {
   // if no equilibrium is found, SettleInterrupted if interrupted (the state
   // is left as it was in both cases).
   const SettleReport& apply(const Action& action);
+  // As apply(action), but the settle starts with the free points at `start`
+  // (3 x N), e.g. the settled state of the same step under nearby
+  // parameters, which a fit's Jacobian replays many times; fixed and pinned
+  // points stay. If that does not settle, settles from the usual start.
+  const SettleReport& apply(const Action& action, const Eigen::Matrix3Xd& start);
 
  private:
   // Settles, then runs the effects' after_settle hooks (ForceModel) and,
   // if they changed the state, settles once more.
   void settle();
   void settle_once();
+  const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
   SimulatorOptions options_;
   ForceModel model_;

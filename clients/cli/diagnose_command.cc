@@ -1,0 +1,178 @@
+#include "diagnose_command.h"
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <iostream>
+
+#include "args.h"
+#include "calib/diagnosis.h"
+#include "calib_args.h"
+#include "fit_report.h"
+#include "html_report.h"
+#include "stage_progress.h"
+
+namespace hj::cli {
+
+namespace {
+
+constexpr const char* kDiagnoseUsage =
+    "usage: hapticjam diagnose DATASET --out DIR [--effects a,b] [--params START] [--max-iterations N]\n"
+    "                          [--segments P] [--threads N]\n"
+    "Which physical effect is the model missing? Fits the baseline, then refits with each\n"
+    "candidate effect of the registry added, judging each by its leave-one-session-out error\n"
+    "and BIC; adds effects greedily while one still helps. Writes DIR/diagnosis.json and\n"
+    "DIR/report.html (with the error ladder).\n"
+    "  --effects a,b   candidates to try (default: every optional effect in the registry)\n"
+    "  --params START  baseline values to start from (default: the paper's)\n";
+
+nlohmann::json candidate_json(const CandidateFit& c) {
+  return {{"effect", c.added},
+          {"effects", c.effects},
+          {"rmse_mm", c.fit.rmse_mm},
+          {"heldout_rmse_mm", c.heldout_rmse_mm},
+          {"delta_bic", c.delta_bic},
+          {"significant", c.significant},
+          {"params", model_params_json(c.fit.params)},
+          {"uncertainties", uncertainties_json(c.fit)}};
+}
+
+std::string num(double v, const char* format = "%.3f") {
+  char b[32];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+int diagnose_dataset(const CalibArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
+  const Dataset dataset = read_dataset(args.dataset);
+  CalibArgs base_args = args;
+  base_args.effects.clear();
+  const ModelParams start_model = start_params(base_args, dataset);
+  DiagnoseOptions options;
+  options.candidates = args.effects;
+  options.fit.least_squares.max_iterations = args.max_iterations;
+  options.fit.least_squares.replay = fitting_replay(replay_options(args));
+  options.fit.bisection.replay = options.fit.least_squares.replay;
+  StageProgress progress;
+  const Diagnosis d = diagnose(dataset, start_model, options, std::ref(progress));
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+
+  nlohmann::json ranking = nlohmann::json::array(), later = nlohmann::json::array(), worst = nlohmann::json::array();
+  for (const auto& c : d.ranking) ranking.push_back(candidate_json(c));
+  for (const auto& c : d.later_rounds) later.push_back(candidate_json(c));
+  for (auto [r, c] : d.pattern.worst_cells) worst.push_back({r, c});
+  nlohmann::json ladder = nlohmann::json::array();
+  for (const auto& step : d.ladder)
+    ladder.push_back({{"model", step.label}, {"rmse_mm", step.rmse_mm}, {"heldout_rmse_mm", step.heldout_rmse_mm}});
+  const LeastSquaresResult& base = d.baseline.joint;
+  const nlohmann::json doc = {
+      {"baseline",
+       {{"rmse_mm", base.rmse_mm},
+        {"heldout_rmse_mm", d.baseline_heldout_rmse_mm},
+        {"r2", base.r2},
+        {"params", model_params_json(base.params)},
+        {"uncertainties", uncertainties_json(base)}}},
+      {"ranking", ranking},
+      {"later_rounds", later},
+      {"verdict", d.verdict},
+      {"worst_cells", worst},
+      {"findings", d.pattern.findings},
+      {"skipped", d.skipped},
+      {"ladder", ladder},
+      {"noise_floor_mm", d.noise_floor_mm},
+      {"final_params", model_params_json(d.final_params)},
+      {"seconds", seconds},
+      {"cpu_seconds", cpu_seconds},
+      {"timing", progress.timing()}};
+  const std::filesystem::path out(args.out);
+  write_json(out / "diagnosis.json", doc);
+  write_model_params(out / "params.json", d.final_params, {{"verdict", d.verdict}});
+
+  const std::string verdict_text =
+      d.verdict.empty() ? "No effect is needed: no candidate lowers the held-out error by a real margin with a "
+                          "better BIC; the baseline explains the data."
+                        : [&] {
+                            std::string s = "The data need: ";
+                            for (size_t k = 0; k < d.verdict.size(); ++k) s += (k ? ", " : "") + d.verdict[k];
+                            return s + ".";
+                          }();
+  HtmlReport html("hapticjam diagnose: " + dataset.dir.filename().string());
+  html.heading("Verdict");
+  html.paragraph(verdict_text);
+  html.heading("Where the baseline's residual concentrates");
+  for (const auto& f : d.pattern.findings) html.paragraph(f);
+  std::vector<std::vector<std::string>> split_rows;
+  for (const auto& s : d.pattern.splits)
+    split_rows.push_back({s.name, num(s.rmse_mm), std::to_string(s.samples), s.other, num(s.other_rmse_mm),
+                          std::to_string(s.other_samples)});
+  html.table({"region", "RMSE mm", "samples", "rest", "RMSE mm", "samples"}, split_rows);
+  html.heading("Error ladder");
+  Plot plot{"Error as each chosen effect is added", "model", "RMSE (mm)", {}, {}, 0.0, d.noise_floor_mm,
+            "noise floor " + num(d.noise_floor_mm, "%.2f")};
+  PlotSeries fitted{"fitted", {}, {}, "#1f77b4"}, heldout{"held out (LOSO)", {}, {}, "#d62728"};
+  for (size_t k = 0; k < d.ladder.size(); ++k) {
+    plot.x_ticks.push_back(d.ladder[k].label);
+    fitted.x.push_back(static_cast<double>(k));
+    fitted.y.push_back(d.ladder[k].rmse_mm);
+    heldout.x.push_back(static_cast<double>(k));
+    heldout.y.push_back(d.ladder[k].heldout_rmse_mm);
+  }
+  plot.series = {fitted, heldout};
+  html.raw(svg_plot(plot));
+  html.heading("Candidates on the baseline (best first)");
+  std::vector<std::vector<std::string>> rows;
+  rows.push_back({"baseline", num(base.rmse_mm), num(d.baseline_heldout_rmse_mm), "0", ""});
+  for (const auto& c : d.ranking)
+    rows.push_back({c.added, num(c.fit.rmse_mm), num(c.heldout_rmse_mm), num(c.delta_bic, "%.1f"),
+                    c.significant ? "significant" : ""});
+  html.table({"effect", "RMSE mm", "held-out RMSE mm", "delta BIC", ""}, rows);
+  if (!d.later_rounds.empty()) {
+    html.heading("Later rounds (on top of the chosen effects)");
+    rows.clear();
+    for (const auto& c : d.later_rounds) {
+      std::string on;
+      for (const auto& e : c.effects) on += (on.empty() ? "" : " + ") + e;
+      rows.push_back({on, num(c.fit.rmse_mm), num(c.heldout_rmse_mm), num(c.delta_bic, "%.1f"),
+                      c.significant ? "significant" : ""});
+    }
+    html.table({"effects", "RMSE mm", "held-out RMSE mm", "delta BIC", ""}, rows);
+  }
+  html.heading("Baseline parameters");
+  for (const auto& l : parameter_lines(base)) html.raw("<pre>" + html_escape(l) + "</pre>");
+  for (const auto& n : loose_notes(base)) html.paragraph(n);
+  html.paragraph("Significant = the leave-one-session-out RMSE falls by at least " +
+                 num(100 * options.min_heldout_gain, "%.0f") + " % and delta BIC < " +
+                 num(options.max_delta_bic, "%.0f") + ". Run time " + num(seconds, "%.1f") + " s (CPU " +
+                 num(cpu_seconds, "%.1f") + " s).");
+  html.write(out / "report.html");
+
+  std::printf("diagnose %s: baseline RMSE %.3f mm (held out %.3f), noise floor %.3f mm\n",
+              dataset.dir.filename().c_str(), base.rmse_mm, d.baseline_heldout_rmse_mm, d.noise_floor_mm);
+  for (const auto& c : d.ranking)
+    std::printf("  %-20s RMSE %.3f  held out %.3f  dBIC %10.1f %s\n", c.added.c_str(), c.fit.rmse_mm,
+                c.heldout_rmse_mm, c.delta_bic, c.significant ? "significant" : "");
+  for (const auto& f : d.pattern.findings) std::printf("%s\n", f.c_str());
+  for (const auto& t : progress.timing())
+    std::printf("  time in %-40s %7.1f s wall %7.1f s CPU\n", t["stage"].get<std::string>().c_str(),
+                t["wall_s"].get<double>(), t["cpu_s"].get<double>());
+  std::printf("%s\nwrote %s in %.1f s (CPU %.1f s)\n", verdict_text.c_str(), (out / "diagnosis.json").c_str(), seconds,
+              cpu_seconds);
+  return 0;
+}
+
+}  // namespace
+
+int run_diagnose(const std::vector<std::string>& args) {
+  return run_subcommand<CalibArgs>(
+      "diagnose", kDiagnoseUsage, args,
+      [](const std::vector<std::string>& a) {
+        return parse_calib_args(a, {"--params", "--effects", "--max-iterations", "--segments", "--threads"});
+      },
+      diagnose_dataset);
+}
+
+}  // namespace hj::cli

@@ -1,0 +1,153 @@
+#include "fit_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "args.h"
+#include "calib/diagnosis.h"
+#include "calib/fit_model.h"
+#include "calib_args.h"
+#include "fit_report.h"
+#include "html_report.h"
+#include "stage_progress.h"
+
+namespace hj::cli {
+
+namespace {
+
+constexpr const char* kFitUsage =
+    "usage: hapticjam fit DATASET --out DIR [--effects a,b] [--holdout NAME,NAME] [--params START]\n"
+    "                     [--max-iterations N] [--no-initial] [--segments P] [--threads N]\n"
+    "Fits the model to the sessions of DATASET: the mass from the levelling pressure, the\n"
+    "spring and jammed bending stiffnesses by the paper's Algorithm 1 (bisection), then every\n"
+    "parameter (the baseline's and the effects') jointly by bounded least squares (Ceres).\n"
+    "Writes DIR/params.json (hapticjam.params/1, loadable by --params; with each parameter's\n"
+    "standard error and 95 % interval, r^2, RMSE) and DIR/report.html.\n"
+    "  --effects a,b       switch these effects on and fit their parameters too\n"
+    "  --holdout A,B       fit without these sessions and report the error on them\n"
+    "  --params START      start from these values (default: the paper's)\n"
+    "  --max-iterations N  least-squares iterations (default 20)\n"
+    "  --no-initial        skip the levelling and Algorithm 1 estimates\n";
+
+int fit(const CalibArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
+  const Dataset all = read_dataset(args.dataset);
+  const Dataset train = select_sessions(all, args.holdout, false);
+  const Dataset held = select_sessions(all, args.holdout, true);
+  if (train.sessions.empty()) throw std::invalid_argument("--holdout leaves no session to fit");
+  const ModelParams start_model = start_params(args, all);
+  FitOptions options;
+  options.initial_estimates = args.initial_estimates;
+  options.least_squares.max_iterations = args.max_iterations;
+  options.least_squares.replay = fitting_replay(replay_options(args));
+  options.bisection.replay = options.least_squares.replay;
+  StageProgress progress;
+  const FitReport report = fit_model(train, start_model, start_model.effects, options, std::ref(progress));
+  const LeastSquaresResult& joint = report.joint;
+
+  nlohmann::json heldout = {{"sessions", args.holdout}};
+  if (!held.sessions.empty()) {
+    const Evaluation e = evaluate_dataset(held, joint.params, options.least_squares.replay,
+                                          [&](int done, int total, const std::string& name) {
+                                            progress("held-out sessions", done, total, name);
+                                          });
+    heldout["rmse_mm"] = e.rmse_mm();
+    heldout["mae_mm"] = e.mae_mm();
+  }
+  progress.finish();
+  const std::vector<std::string> notes = loose_notes(joint);
+  nlohmann::json levelling = {{"found", report.levelling.found}};
+  if (report.levelling.found)
+    levelling.update({{"pressure_pa", report.levelling.pressure_pa},
+                      {"mass_kg", report.levelling.mass_kg},
+                      {"session", report.levelling.session},
+                      {"between_pa", {report.levelling.below_pa, report.levelling.above_pa}}});
+  nlohmann::json algorithm1 = nlohmann::json::object();
+  for (const auto& s : report.stiffnesses)
+    algorithm1[s.parameter] = {{"value", s.result.value},
+                               {"bracketed", s.result.bracketed},
+                               {"captures", s.result.captures},
+                               {"evaluations", s.result.evaluations}};
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  const nlohmann::json extra = {{"rmse_mm", joint.rmse_mm},
+                                {"r2", joint.r2},
+                                {"samples", joint.residual_count},
+                                {"noise_floor_mm", noise_floor_mm(all)},
+                                {"uncertainties", uncertainties_json(joint)},
+                                {"notes", notes},
+                                {"heldout", heldout},
+                                {"levelling", levelling},
+                                {"algorithm1", algorithm1},
+                                {"least_squares", {{"iterations", joint.iterations},
+                                                   {"jacobians", joint.jacobians},
+                                                   {"termination", joint.termination}}},
+                                {"dataset", all.dir.string()},
+                                {"seconds", seconds},
+                                {"cpu_seconds", cpu_seconds},
+                                {"timing", progress.timing()}};
+  const std::filesystem::path out(args.out);
+  write_model_params(out / "params.json", joint.params, extra);
+
+  HtmlReport html("hapticjam fit: " + all.dir.filename().string());
+  char line[256];
+  if (report.levelling.found) {
+    std::snprintf(line, sizeof line,
+                  "Levelling: the centre crosses the level at %.1f Pa (between %.0f and %.0f Pa in %s), so M = P A / g "
+                  "= %.4f kg.",
+                  report.levelling.pressure_pa, report.levelling.below_pa, report.levelling.above_pa,
+                  report.levelling.session.c_str(), report.levelling.mass_kg);
+    html.paragraph(line);
+  } else {
+    html.paragraph("Levelling: no unjammed session crosses the level; the mass starts from the given value.");
+  }
+  for (const auto& s : report.stiffnesses) {
+    std::snprintf(line, sizeof line, "Algorithm 1 (bisection) for %s over %d captures: %.5g%s.", s.parameter.c_str(),
+                  s.result.captures, s.result.value, s.result.bracketed ? "" : " (not bracketed; start value kept)");
+    html.paragraph(line);
+  }
+  std::snprintf(line, sizeof line, "Joint bounded least squares (%d iterations): RMSE %.3f mm, r^2 = %.5f over %ld samples.",
+                joint.iterations, joint.rmse_mm, joint.r2, joint.residual_count);
+  html.paragraph(line);
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& e : joint.estimates) {
+    auto num = [](double v) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.5g", v);
+      return std::string(b);
+    };
+    rows.push_back({e.parameter.qualified_name(), num(e.value), e.parameter.spec.unit,
+                    e.active ? num(e.std_error) : "-",
+                    e.active ? num(e.ci95_low) + " .. " + num(e.ci95_high) : "not estimated (no effect)",
+                    e.loose ? "loose" : ""});
+  }
+  html.table({"parameter", "value", "unit", "std. error", "95 % interval", ""}, rows);
+  for (const auto& n : notes) html.paragraph(n);
+  if (heldout.contains("rmse_mm")) html.paragraph("Held-out sessions: RMSE " + heldout["rmse_mm"].dump() + " mm.");
+  html.write(out / "report.html");
+
+  std::printf("fit %s (%zu sessions, %ld samples): RMSE %.3f mm, r^2 %.5f\n", all.dir.filename().c_str(),
+              train.sessions.size(), joint.residual_count, joint.rmse_mm, joint.r2);
+  for (const auto& l : parameter_lines(joint)) std::printf("  %s\n", l.c_str());
+  for (const auto& n : notes) std::printf("note: %s\n", n.c_str());
+  if (heldout.contains("rmse_mm")) std::printf("held-out RMSE %.3f mm\n", heldout["rmse_mm"].get<double>());
+  std::printf("wrote %s in %.1f s (CPU %.1f s)\n", (out / "params.json").c_str(), seconds, cpu_seconds);
+  return 0;
+}
+
+}  // namespace
+
+int run_fit(const std::vector<std::string>& args) {
+  return run_subcommand<CalibArgs>(
+      "fit", kFitUsage, args,
+      [](const std::vector<std::string>& a) {
+        return parse_calib_args(a, {"--params", "--effects", "--holdout", "--max-iterations", "--no-initial",
+                                    "--segments", "--threads"});
+      },
+      fit);
+}
+
+}  // namespace hj::cli

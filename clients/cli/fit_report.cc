@@ -1,0 +1,57 @@
+#include "fit_report.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace hj::cli {
+
+nlohmann::json uncertainties_json(const LeastSquaresResult& fit) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& e : fit.estimates) {
+    nlohmann::json entry = {{"value", e.value}, {"unit", e.parameter.spec.unit}, {"active", e.active}};
+    if (e.active) {
+      entry["std_error"] = e.std_error;
+      entry["ci95"] = {e.ci95_low, e.ci95_high};
+      entry["at_bound"] = e.at_bound;
+      entry["loose"] = e.loose;
+    }
+    out[e.parameter.qualified_name()] = entry;
+  }
+  return out;
+}
+
+std::vector<std::string> parameter_lines(const LeastSquaresResult& fit) {
+  std::vector<std::string> out;
+  char line[256];
+  for (const auto& e : fit.estimates) {
+    const std::string name = e.parameter.qualified_name();
+    const char* unit = e.parameter.spec.unit.c_str();
+    if (!e.active) {
+      std::snprintf(line, sizeof line, "%-24s %.6g %s (changes no capture; kept, not estimated)", name.c_str(), e.value,
+                    unit);
+    } else {
+      std::snprintf(line, sizeof line, "%-24s %.6g %s +- %.3g (95 %%: %.6g .. %.6g)%s%s", name.c_str(), e.value, unit,
+                    1.96 * e.std_error, e.ci95_low, e.ci95_high, e.loose ? "  LOOSELY CONSTRAINED" : "",
+                    e.at_bound ? "  at a bound" : "");
+    }
+    out.push_back(line);
+  }
+  return out;
+}
+
+std::vector<std::string> loose_notes(const LeastSquaresResult& fit) {
+  std::vector<std::string> out;
+  char line[320];
+  for (const auto& e : fit.estimates) {
+    if (!e.active || !e.loose) continue;
+    std::snprintf(line, sizeof line,
+                  "%s is only loosely constrained by these sessions: its 95 %% interval %.4g .. %.4g %s is %.0f %% of "
+                  "its value wide; sessions that load it more would pin it down.",
+                  e.parameter.qualified_name().c_str(), e.ci95_low, e.ci95_high, e.parameter.spec.unit.c_str(),
+                  100.0 * (e.ci95_high - e.ci95_low) / std::max(std::abs(e.value), 1e-300));
+    out.push_back(line);
+  }
+  return out;
+}
+
+}  // namespace hj::cli

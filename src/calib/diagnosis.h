@@ -1,0 +1,67 @@
+// Which effect is the model missing? Fit the baseline; refit with each
+// candidate effect of the registry added; judge each by its cross-validated
+// (leave-one-session-out) error and by BIC, so that an effect that only adds
+// freedom is not chosen; then add effects greedily while one still helps.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/cross_validation.h"
+#include "calib/fit_model.h"
+#include "calib/residual_pattern.h"
+
+namespace hj {
+
+struct DiagnoseOptions {
+  FitOptions fit;               // the baseline fit (levelling, Algorithm 1, joint)
+  std::vector<std::string> candidates;  // empty: every non-baseline effect in the registry
+  int max_effects = 3;          // greedy selection stops after this many
+  // Significant = the held-out RMSE falls by at least this share of the
+  // current model's AND delta BIC is below max_delta_bic (see diagnosis.cc).
+  double min_heldout_gain = 0.01;
+  double max_delta_bic = -10.0;
+};
+
+struct CandidateFit {
+  std::vector<std::string> effects;  // switched on (beyond the baseline)
+  std::string added;                 // the effect this candidate adds
+  LeastSquaresResult fit;
+  double heldout_rmse_mm = 0.0;
+  double delta_bic = 0.0;            // against the model it extends
+  bool significant = false;
+};
+
+struct LadderStep {
+  std::string label;  // "baseline", "+ bending", ...
+  double rmse_mm = 0.0;
+  double heldout_rmse_mm = 0.0;
+};
+
+struct Diagnosis {
+  FitReport baseline;
+  double baseline_heldout_rmse_mm = 0.0;
+  std::vector<CandidateFit> ranking;  // each candidate on the baseline, best first
+  std::vector<CandidateFit> later_rounds;  // candidates tried on top of chosen effects
+  std::vector<std::string> verdict;   // chosen effects, in the order added; empty: none needed
+  ModelParams final_params;
+  std::vector<LadderStep> ladder;
+  ResidualPattern pattern;            // of the baseline at its optimum
+  std::vector<std::string> skipped;   // candidates that failed to fit, with why
+  double noise_floor_mm = 0.0;
+};
+
+// BIC of a least-squares fit with Gaussian residuals: n ln(SSR / n) + p ln n.
+double bic(const LeastSquaresResult& fit);
+
+// The RMSE a perfect model leaves: the sensor's accuracy taken as its noise
+// sigma, plus the rounding to its resolution (res^2 / 12).
+double noise_floor_mm(const Dataset& dataset);
+
+using DiagnoseProgress = std::function<void(const std::string& stage, int done, int total, const std::string& detail)>;
+
+Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const DiagnoseOptions& options,
+                   const DiagnoseProgress& progress = {});
+
+}  // namespace hj

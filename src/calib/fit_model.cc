@@ -1,0 +1,88 @@
+#include "calib/fit_model.h"
+
+#include <cstdio>
+#include <exception>
+
+namespace hj {
+
+namespace {
+
+const FitParameter* find_parameter(const std::vector<FitParameter>& parameters, const std::string& name) {
+  for (const auto& p : parameters)
+    if (p.surface && p.spec.name == name) return &p;
+  return nullptr;
+}
+
+// The levelling estimate from a coarse pressure sweep is only within a few
+// per cent, and the jammed captures taken at the levelling pressure depend
+// on the mass steeply (the level state is where the net turns from sag to
+// dome). So before the jammed bending stiffness, the mass and spring
+// stiffness are refined together by least squares on the bare (unjammed,
+// unpinned) captures, where the surface depends on them smoothly.
+void refine_on_bare_captures(const Dataset& dataset, const std::vector<FitParameter>& parameters,
+                             const FitOptions& options, const FitProgress& progress, FitReport& out) {
+  const Dataset bare =
+      sessions_up_to(dataset, [](const MeasuredCapture& c) { return c.jammed_count() == 0 && c.pinned.empty(); });
+  std::vector<FitParameter> surface;
+  for (const auto& p : parameters)
+    if (p.spec.name == "mass_kg" || p.spec.name == "spring_k") surface.push_back(p);
+  if (bare.sessions.empty() || surface.empty()) return;
+  try {
+    const LeastSquaresResult r =
+        fit_least_squares(bare, out.initial, surface, options.least_squares, [&](int iteration, int max, double rmse) {
+          char detail[64];
+          std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
+          if (progress) progress("least squares on the bare captures", iteration, max, detail);
+        });
+    out.initial = r.params;
+    out.bare_rmse_mm = r.rmse_mm;
+  } catch (const std::exception&) {
+    // Keep the estimates so far; the joint fit starts from them.
+  }
+}
+
+}  // namespace
+
+FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,
+                    const FitOptions& options, const FitProgress& progress) {
+  FitReport out;
+  out.start = with_effects(start, effects);
+  out.initial = out.start;
+  const std::vector<FitParameter> parameters = fit_parameters(out.initial.effects);
+  if (options.initial_estimates) {
+    out.levelling = levelling_mass(dataset, out.initial.surface.gravity);
+    if (progress) progress("levelling", 1, 1, out.levelling.found ? "zero crossing found" : "no zero crossing");
+    if (out.levelling.found) {
+      const FitParameter* mass = find_parameter(parameters, "mass_kg");
+      if (mass && out.levelling.mass_kg >= mass->spec.lower && out.levelling.mass_kg <= mass->spec.upper)
+        out.initial.surface.mass_kg = out.levelling.mass_kg;
+    }
+    // Algorithm 1: the spring stiffness on the bare (unjammed, unpinned)
+    // captures, then the jammed bending stiffness on the jammed, unpinned.
+    const std::pair<const char*, CaptureFilter> stiffnesses[] = {
+        {"spring_k", [](const MeasuredCapture& c) { return c.jammed_count() == 0 && c.pinned.empty(); }},
+        {"kappa_jam", [](const MeasuredCapture& c) { return c.jammed_count() > 0 && c.pinned.empty(); }},
+    };
+    for (const auto& [name, filter] : stiffnesses) {
+      const FitParameter* p = find_parameter(parameters, name);
+      if (!p) continue;
+      if (std::string(name) == "kappa_jam") refine_on_bare_captures(dataset, parameters, options, progress, out);
+      const std::string stage = std::string("algorithm 1: ") + name;
+      BisectionResult r = fit_stiffness_by_bisection(dataset, out.initial, *p, filter, options.bisection,
+                                                     [&](int done, int total) {
+                                                       if (progress) progress(stage, done, total, "");
+                                                     });
+      if (r.bracketed) set_parameter_value(out.initial, *p, r.value);
+      out.stiffnesses.push_back({name, r});
+    }
+  }
+  out.joint = fit_least_squares(dataset, out.initial, parameters, options.least_squares,
+                                [&](int iteration, int max_iterations, double rmse) {
+                                  char detail[64];
+                                  std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
+                                  if (progress) progress("least squares", iteration, max_iterations, detail);
+                                });
+  return out;
+}
+
+}  // namespace hj

@@ -1,0 +1,47 @@
+// A full fit of a model to a dataset, the paper's way then jointly: the mass
+// from the levelling pressure (levelling.h), the spring stiffness by
+// Algorithm 1 (stiffness_bisection.h), mass and spring stiffness refined on
+// the bare captures, the jammed bending stiffness by Algorithm 1, then every
+// parameter of the baseline and the switched-on effects by bounded least
+// squares (least_squares.h) from there.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/least_squares.h"
+#include "calib/levelling.h"
+#include "calib/stiffness_bisection.h"
+
+namespace hj {
+
+struct FitOptions {
+  bool initial_estimates = true;  // levelling and Algorithm 1 before the joint fit
+  BisectionOptions bisection;
+  LeastSquaresOptions least_squares;
+};
+
+struct StiffnessEstimate {
+  std::string parameter;
+  BisectionResult result;
+};
+
+struct FitReport {
+  ModelParams start;
+  LevellingEstimate levelling;
+  std::vector<StiffnessEstimate> stiffnesses;
+  ModelParams initial;  // after levelling, Algorithm 1 and the refit on the bare captures
+  double bare_rmse_mm = 0.0;  // of that refit (0 if not run)
+  LeastSquaresResult joint;
+};
+
+// Stage ("levelling", "algorithm 1: spring_k", "least squares"), progress.
+using FitProgress = std::function<void(const std::string& stage, int done, int total, const std::string& detail)>;
+
+// Fits the baseline plus `effects` (switched on with their defaults unless
+// `start` has values for them).
+FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,
+                    const FitOptions& options, const FitProgress& progress = {});
+
+}  // namespace hj

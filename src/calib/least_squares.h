@@ -1,0 +1,78 @@
+// All parameters jointly by bounded nonlinear least squares on the frame
+// residuals (residuals.h: predicted - measured, every seen sample of every
+// capture), with Ceres' Levenberg-Marquardt. The Jacobian is by forward
+// differences, its columns and the sessions computed in parallel. Each
+// parameter gets a standard error and a 95 % interval from the Gauss-Newton
+// covariance s^2 (J^T J)^-1 at the optimum, s^2 = SSR / (n - p).
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/fit_parameters.h"
+#include "calib/residuals.h"
+
+namespace hj {
+
+struct LeastSquaresOptions {
+  int max_iterations = 20;
+  double function_tolerance = 1e-5;  // relative change of the cost that ends the fit (1e-5 of 1.7e5 samples: about 2 mm^2)
+  double difference_step = 3e-3;     // forward-difference step, relative to each parameter's scale
+  // A parameter whose 95 % half-width exceeds this share of its value is
+  // reported as only loosely constrained by the data.
+  double loose_relative_halfwidth = 0.1;
+  ReplayOptions replay = fitting_replay({});
+};
+
+struct ParameterEstimate {
+  FitParameter parameter;
+  double value = 0.0;
+  double std_error = 0.0;  // NaN if not estimated
+  double ci95_low = 0.0;
+  double ci95_high = 0.0;
+  // false: moving it does not change any capture (e.g. the damping under a
+  // static settle), so it is held at its start value and not estimated.
+  bool active = true;
+  bool at_bound = false;
+  bool loose = false;
+};
+
+struct LeastSquaresResult {
+  ModelParams params;
+  std::vector<ParameterEstimate> estimates;  // parallel to the parameters given
+  long residual_count = 0;                   // n
+  int free_parameters = 0;                   // p, the active ones
+  double sum_sq_mm2 = 0.0;
+  double rmse_mm = 0.0;
+  double r2 = 0.0;  // 1 - SSR / SST over all compared samples, as the paper reports it
+  int iterations = 0;
+  int jacobians = 0;
+  std::string termination;
+  // At the optimum, for cross-validation without refitting from scratch:
+  // the residuals (n), the Jacobian (n x p) in the scaled variables
+  // u = value / scale of the active parameters, and each session's first
+  // row (session_rows[s] .. session_rows[s + 1]).
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd scale;
+  std::vector<int> active;  // indices into estimates
+  std::vector<int> session_rows;
+};
+
+// Called after each iteration: iteration, the most there may be, the RMSE.
+using LeastSquaresProgress = std::function<void(int iteration, int max_iterations, double rmse_mm)>;
+
+// @throws std::invalid_argument if the dataset has no samples or a start
+//         value lies outside its parameter's bounds (naming it).
+LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& start,
+                                     const std::vector<FitParameter>& parameters, const LeastSquaresOptions& options,
+                                     const LeastSquaresProgress& progress = {});
+
+// The residuals of every session stacked in dataset order, and the first
+// row of each (rows.size() == sessions + 1). Sessions run in parallel.
+Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
+                                  std::vector<int>* rows = nullptr);
+
+}  // namespace hj

@@ -1,0 +1,161 @@
+#include "calib/residuals.h"
+
+#include <cmath>
+#include <limits>
+#include <mutex>
+
+#include "calib/parallel_for.h"
+
+namespace hj {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::vector<PredictedCapture> predict(const MeasuredSession& session, const ModelParams& params,
+                                      const ReplayOptions& options, const ReplayTrace* warm_start = nullptr,
+                                      ReplayTrace* trace = nullptr) {
+  return replay_session(session.session, options.segments, params.surface, simulator_options(params, options), {},
+                        warm_start, trace);
+}
+
+}  // namespace
+
+double CaptureError::rmse_mm() const { return samples ? std::sqrt(sum_sq_mm2 / samples) : kNaN; }
+double CaptureError::mae_mm() const { return samples ? sum_abs_mm / samples : kNaN; }
+double CaptureError::share_within_accuracy() const {
+  return samples ? static_cast<double>(within_accuracy) / samples : kNaN;
+}
+
+CaptureError compare_capture(const Eigen::MatrixXd& predicted_mm, const Eigen::MatrixXd& measured_mm,
+                             double accuracy_mm) {
+  if (predicted_mm.rows() != measured_mm.rows() || predicted_mm.cols() != measured_mm.cols())
+    throw std::invalid_argument("compare_capture: predicted and measured frames differ in shape");
+  CaptureError out;
+  out.residual_mm = Eigen::MatrixXd::Constant(measured_mm.rows(), measured_mm.cols(), kNaN);
+  double sum = 0.0;
+  for (int iy = 0; iy < measured_mm.rows(); ++iy)
+    for (int ix = 0; ix < measured_mm.cols(); ++ix) {
+      const double measured = measured_mm(iy, ix), predicted = predicted_mm(iy, ix);
+      if (std::isnan(measured)) continue;
+      if (std::isnan(predicted)) {
+        ++out.uncovered;
+        continue;
+      }
+      const double r = predicted - measured;
+      out.residual_mm(iy, ix) = r;
+      ++out.samples;
+      sum += r;
+      out.sum_sq_mm2 += r * r;
+      out.sum_abs_mm += std::abs(r);
+      out.max_mm = std::max(out.max_mm, std::abs(r));
+      if (std::abs(r) <= accuracy_mm) ++out.within_accuracy;
+    }
+  out.mean_mm = out.samples ? sum / out.samples : kNaN;
+  return out;
+}
+
+bool cell_of_sample(const Session& session, int ix, int iy, int& r, int& c) {
+  const double s = session.device.cell_size_mm;
+  const double x = session.grid.x_mm(ix), y = session.grid.y_mm(iy);
+  if (x < 0.0 || y < 0.0 || x > session.device.cols * s || y > session.device.rows * s) return false;
+  c = std::min(static_cast<int>(std::floor(x / s)), session.device.cols - 1);
+  r = std::min(static_cast<int>(std::floor(y / s)), session.device.rows - 1);
+  return true;
+}
+
+double Evaluation::rmse_mm() const { return samples ? std::sqrt(sum_sq_mm2 / samples) : kNaN; }
+double Evaluation::mae_mm() const { return samples ? sum_abs_mm / samples : kNaN; }
+Eigen::MatrixXd Evaluation::cell_rmse_mm() const {
+  Eigen::MatrixXd out(cell_samples.rows(), cell_samples.cols());
+  for (int r = 0; r < out.rows(); ++r)
+    for (int c = 0; c < out.cols(); ++c)
+      out(r, c) = cell_samples(r, c) > 0 ? std::sqrt(cell_sum_sq_mm2(r, c) / cell_samples(r, c)) : kNaN;
+  return out;
+}
+
+ReplayOptions fitting_replay(ReplayOptions options) {
+  options.fallback_max_steps = std::min(options.fallback_max_steps, 20'000L);
+  return options;
+}
+
+SimulatorOptions simulator_options(const ModelParams& params, const ReplayOptions& options) {
+  SimulatorOptions out;
+  out.static_options = options.solver;
+  out.fallback_max_steps = options.fallback_max_steps;
+  params.apply_to(out);
+  return out;
+}
+
+Evaluation evaluate_dataset(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
+                            const EvaluationProgress& progress, const std::vector<ReplayTrace>* warm_start,
+                            std::vector<ReplayTrace>* traces) {
+  const int n = static_cast<int>(dataset.sessions.size());
+  if (traces) traces->assign(n, ReplayTrace());
+  Evaluation out;
+  out.sessions.resize(n);
+  std::mutex mutex;
+  int done = 0;
+  parallel_for(
+      n,
+      [&](int i) {
+        const MeasuredSession& measured = dataset.sessions[i];
+        SessionEvaluation& result = out.sessions[i];
+        result.name = measured.session.name;
+        const ReplayTrace* hint = warm_start && i < static_cast<int>(warm_start->size()) && !(*warm_start)[i].empty()
+                                      ? &(*warm_start)[i]
+                                      : nullptr;
+        result.predicted = predict(measured, params, options, hint, traces ? &(*traces)[i] : nullptr);
+        for (size_t k = 0; k < measured.captures.size(); ++k)
+          result.captures.push_back(compare_capture(result.predicted[k].heights_mm, measured.captures[k].heights_mm,
+                                                    measured.session.sensor_accuracy_mm));
+        std::lock_guard lock(mutex);
+        if (progress) progress(++done, n, result.name);
+      },
+      options.threads);
+  const SessionDevice& device = dataset.device();
+  out.cell_sum_sq_mm2 = Eigen::MatrixXd::Zero(device.rows, device.cols);
+  out.cell_samples = Eigen::MatrixXd::Zero(device.rows, device.cols);
+  for (int i = 0; i < n; ++i) {
+    const Session& session = dataset.sessions[i].session;
+    for (const CaptureError& e : out.sessions[i].captures) {
+      out.samples += e.samples;
+      out.sum_sq_mm2 += e.sum_sq_mm2;
+      out.sum_abs_mm += e.sum_abs_mm;
+      for (int iy = 0; iy < e.residual_mm.rows(); ++iy)
+        for (int ix = 0; ix < e.residual_mm.cols(); ++ix) {
+          const double res = e.residual_mm(iy, ix);
+          int r = 0, c = 0;
+          if (std::isnan(res) || !cell_of_sample(session, ix, iy, r, c)) continue;
+          out.cell_sum_sq_mm2(r, c) += res * res;
+          out.cell_samples(r, c) += 1;
+        }
+    }
+  }
+  return out;
+}
+
+int residual_count(const MeasuredSession& session) {
+  int n = 0;
+  for (const auto& c : session.captures) n += static_cast<int>((c.heights_mm.array() == c.heights_mm.array()).count());
+  return n;
+}
+
+Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelParams& params,
+                                  const ReplayOptions& options, const ReplayTrace* warm_start, ReplayTrace* trace) {
+  const auto predicted = predict(session, params, options, warm_start, trace);
+  Eigen::VectorXd out(residual_count(session));
+  int k = 0;
+  for (size_t c = 0; c < session.captures.size(); ++c) {
+    const Eigen::MatrixXd& measured = session.captures[c].heights_mm;
+    for (int iy = 0; iy < measured.rows(); ++iy)
+      for (int ix = 0; ix < measured.cols(); ++ix) {
+        if (std::isnan(measured(iy, ix))) continue;
+        const double p = predicted[c].heights_mm(iy, ix);
+        out[k++] = std::isnan(p) ? 0.0 : p - measured(iy, ix);
+      }
+  }
+  return out;
+}
+
+}  // namespace hj

@@ -1,0 +1,97 @@
+// Model versus measurement: each capture of a dataset predicted by replaying
+// its session (replay.h) and compared with the measured frame, sample by
+// sample. Missing samples (NaN in the frame) and samples no triangle of the
+// predicted surface covers are not compared. Sessions run in parallel.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/dataset.h"
+#include "calib/model_params.h"
+#include "calib/replay.h"
+
+namespace hj {
+
+struct ReplayOptions {
+  int segments = 4;  // p, mesh segments per cell edge
+  StaticSolverOptions solver;
+  int threads = 0;   // 0: one per core
+  // Explicit steps a failed static settle may fall back to. A fit probes
+  // parameters where the model has no equilibrium (the net creases just
+  // below levelling), and must learn that quickly; see fitting_replay().
+  long fallback_max_steps = 2'000'000;
+};
+
+// The options of fits: a short explicit fallback.
+ReplayOptions fitting_replay(ReplayOptions options);
+
+// The error of one capture, residual = predicted - measured.
+struct CaptureError {
+  int samples = 0;             // compared
+  int uncovered = 0;           // measured, but not covered by the prediction
+  int within_accuracy = 0;     // |residual| <= the sensor's accuracy
+  double sum_sq_mm2 = 0.0;
+  double sum_abs_mm = 0.0;
+  double max_mm = 0.0;         // largest |residual|
+  double mean_mm = 0.0;        // mean signed residual
+  Eigen::MatrixXd residual_mm;  // (ny x nx), NaN where not compared
+
+  double rmse_mm() const;
+  double mae_mm() const;
+  double share_within_accuracy() const;
+};
+
+CaptureError compare_capture(const Eigen::MatrixXd& predicted_mm, const Eigen::MatrixXd& measured_mm,
+                             double accuracy_mm);
+
+// The cell (r, c) whose footprint holds sample (ix, iy), or false if the
+// sample lies outside the array. Samples on a shared border go to the cell
+// of higher index, those on the far edge to the last cell.
+bool cell_of_sample(const Session& session, int ix, int iy, int& r, int& c);
+
+struct SessionEvaluation {
+  std::string name;
+  std::vector<PredictedCapture> predicted;
+  std::vector<CaptureError> captures;  // parallel to MeasuredSession::captures
+};
+
+struct Evaluation {
+  std::vector<SessionEvaluation> sessions;  // parallel to Dataset::sessions
+  long samples = 0;
+  double sum_sq_mm2 = 0.0;
+  double sum_abs_mm = 0.0;
+  Eigen::MatrixXd cell_sum_sq_mm2;  // (R x C)
+  Eigen::MatrixXd cell_samples;     // (R x C)
+
+  double rmse_mm() const;
+  double mae_mm() const;
+  Eigen::MatrixXd cell_rmse_mm() const;  // (R x C), NaN for a cell without samples
+};
+
+// Called as each session finishes: sessions done, in all, and its name.
+using EvaluationProgress = std::function<void(int done, int total, const std::string& session)>;
+
+// The parameters' simulator options (their effects switched on).
+SimulatorOptions simulator_options(const ModelParams& params, const ReplayOptions& options);
+
+// Replays every session with `params` and compares every capture.
+// @throws SessionError naming the session and step whose action fails.
+// warm_start / traces: one ReplayTrace per session (see replay.h).
+Evaluation evaluate_dataset(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
+                            const EvaluationProgress& progress = {}, const std::vector<ReplayTrace>* warm_start = nullptr,
+                            std::vector<ReplayTrace>* traces = nullptr);
+
+// The least-squares residuals of one session: predicted - measured in mm at
+// every sample the camera saw, capture by capture, row by row; 0 where the
+// prediction does not cover the sample, so that the layout depends on the
+// measurement only (residual_count entries).
+// warm_start / trace: as replay_session's (replay.h).
+Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelParams& params,
+                                  const ReplayOptions& options, const ReplayTrace* warm_start = nullptr,
+                                  ReplayTrace* trace = nullptr);
+int residual_count(const MeasuredSession& session);
+
+}  // namespace hj

@@ -1,0 +1,50 @@
+// The hot paths of a fit: comparing a capture with its frame, and replaying
+// a session cold versus warm-started from the settled states of nearby
+// parameters (what each Jacobian column does).
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+#include "calib/residuals.h"
+
+namespace {
+
+const std::filesystem::path kBaseline = std::filesystem::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline";
+
+hj::ModelParams true_params() {
+  hj::ModelParams p;
+  p.surface.mass_kg = 0.52;
+  p.surface.spring_k = 58.0;
+  p.surface.kappa_jam = 4.2;
+  return p;
+}
+
+const hj::MeasuredSession& session(const std::string& name) {
+  static const hj::Dataset d = hj::read_dataset(kBaseline);
+  for (const auto& s : d.sessions)
+    if (s.session.name == name) return s;
+  throw std::runtime_error("no session " + name);
+}
+
+void BM_CompareCapture(benchmark::State& state) {
+  const auto& s = session("mixed-1");
+  const Eigen::MatrixXd predicted = s.captures[0].heights_mm.array() + 0.5;
+  for (auto _ : state) benchmark::DoNotOptimize(hj::compare_capture(predicted, s.captures[0].heights_mm, 1.0));
+}
+BENCHMARK(BM_CompareCapture)->Unit(benchmark::kMicrosecond);
+
+// Arg: 0 cold, 1 warm-started from the replay at spring_k 1 % lower.
+void BM_SessionResiduals(benchmark::State& state, const std::string& name) {
+  const auto& s = session(name);
+  const hj::ReplayOptions options;
+  hj::ModelParams nearby = true_params();
+  nearby.surface.spring_k *= 0.99;
+  hj::ReplayTrace trace;
+  hj::session_residuals(s, nearby, options, nullptr, &trace);
+  const hj::ReplayTrace* warm = state.range(0) ? &trace : nullptr;
+  for (auto _ : state) benchmark::DoNotOptimize(hj::session_residuals(s, true_params(), options, warm));
+}
+BENCHMARK_CAPTURE(BM_SessionResiduals, unjammed_sweep, std::string("unjammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SessionResiduals, jammed_sweep, std::string("jammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
