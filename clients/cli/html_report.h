@@ -9,7 +9,7 @@
 
 namespace hj::cli {
 
-struct PlotSeries {
+struct SvgSeries {
   std::string name;
   std::vector<double> x, y;
   std::string colour = "#1f77b4";
@@ -19,7 +19,7 @@ struct PlotSeries {
 
 struct Plot {
   std::string title, x_label, y_label;
-  std::vector<PlotSeries> series;
+  std::vector<SvgSeries> series;
   std::vector<std::string> x_ticks;  // if set: category labels at x = 0, 1, ...
   double y_min = 0.0;                // the y axis starts here (0 for errors)
   // Horizontal reference line (e.g. the noise floor); drawn if label is set.
