@@ -9,7 +9,7 @@ packages=(
   libboost-dev libboost-system-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   libopencv-dev libassimp-dev libsqlite3-dev libgdal-dev libceres-dev
-  python3 python3-grpcio python3-protobuf
+  python3 python3-grpcio python3-protobuf openssl
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -333,5 +333,35 @@ class DeviceTest(unittest.TestCase):
         return path
 
 
+class TlsTest(unittest.TestCase):
+    """--tls-cert/--tls-key: a client that trusts the certificate is served;
+    a plaintext client is not."""
+
+    def test_a_trusting_client_is_served_and_plaintext_is_refused(self):
+        folder = tempfile.mkdtemp(prefix="hj_py_tls_")
+        cert, key = os.path.join(folder, "cert.pem"), os.path.join(folder, "key.pem")
+        subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1",
+                        "-keyout", key, "-out", cert, "-subj", "/CN=localhost",
+                        "-addext", "subjectAltName=DNS:localhost,IP:127.0.0.1"],
+                       check=True, capture_output=True)
+        rig = Rig(["--tls-cert", cert, "--tls-key", key])
+        try:
+            with open(cert, "rb") as f:
+                trusted = Client(rig.address, root_certificates=f.read())
+            try:
+                self.assertIn("algorithm2", [p for p in trusted.planners().planners])
+            finally:
+                trusted.close()
+            plain = Client(rig.address)
+            try:
+                with self.assertRaises(ClientError) as refused:
+                    plain.planners(timeout=5)
+                self.assertEqual(refused.exception.code, grpc.StatusCode.UNAVAILABLE)
+            finally:
+                plain.close()
+        finally:
+            rig.close()
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
