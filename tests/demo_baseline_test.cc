@@ -12,7 +12,9 @@
 
 #include "calib/frame_csv.h"
 #include "calib/replay.h"
+#include "calib/residuals.h"
 #include "calib/session.h"
+#include "demo_truth.h"
 
 namespace hj {
 namespace {
@@ -21,35 +23,22 @@ namespace fs = std::filesystem;
 
 const fs::path kBaseline = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline";
 
-SurfaceParameters true_parameters() {
-  SurfaceParameters p;
-  p.mass_kg = 0.52;
-  p.spring_k = 58.0;
-  p.kappa_jam = 4.2;
-  return p;
-}
+using testing_support::demo_true_parameters;
 
 void expect_session_reproduced(const std::string& name, int expected_captures) {
   const Session session = read_session(kBaseline / name);
-  const auto predicted = replay_session(session, 4, true_parameters(), SimulatorOptions{});
+  const auto predicted = replay_session(session, 4, demo_true_parameters(), SimulatorOptions{});
   ASSERT_EQ(static_cast<int>(predicted.size()), expected_captures);
   for (const PredictedCapture& capture : predicted) {
     SCOPED_TRACE(name + "/" + capture.frame);
     const Eigen::MatrixXd real = read_frame_csv(session.dir / capture.frame, session.grid.ny, session.grid.nx);
     ASSERT_EQ(capture.heights_mm.rows(), real.rows());
     ASSERT_EQ(capture.heights_mm.cols(), real.cols());
-    double sum = 0.0;
-    int count = 0;
-    for (int iy = 0; iy < real.rows(); ++iy)
-      for (int ix = 0; ix < real.cols(); ++ix) {
-        const double a = capture.heights_mm(iy, ix), b = real(iy, ix);
-        if (std::isnan(a) || std::isnan(b)) continue;
-        sum += std::abs(a - b);
-        ++count;
-      }
+    const CaptureError error = compare_capture(capture.heights_mm, real, 1.0);
+    const int count = error.samples;
     // About 1 % of the samples are dropped; the rest must be compared.
     EXPECT_GT(count, 0.95 * real.size());
-    const double mad = sum / std::max(count, 1);
+    const double mad = error.mae_mm();
     std::cout << "  " << name << "/" << capture.frame << " (" << capture.label << "): mean |diff| " << mad
               << " mm over " << count << " samples\n";
     EXPECT_LE(mad, 1.2) << "mean absolute difference, mm";

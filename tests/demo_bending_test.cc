@@ -13,7 +13,9 @@
 
 #include "calib/frame_csv.h"
 #include "calib/replay.h"
+#include "calib/residuals.h"
 #include "calib/session.h"
+#include "demo_truth.h"
 
 namespace hj {
 namespace {
@@ -22,13 +24,7 @@ namespace fs = std::filesystem;
 
 const fs::path kBending = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-bending";
 
-SurfaceParameters true_parameters() {
-  SurfaceParameters p;
-  p.mass_kg = 0.52;
-  p.spring_k = 58.0;
-  p.kappa_jam = 4.2;
-  return p;
-}
+using testing_support::demo_true_parameters;
 
 SimulatorOptions with_bending(double kappa_bend) {
   SimulatorOptions o;
@@ -40,21 +36,13 @@ SimulatorOptions with_bending(double kappa_bend) {
 // Largest mean absolute difference (mm) over the session's captures.
 double worst_capture_mad(const std::string& name, const SimulatorOptions& options) {
   const Session session = read_session(kBending / name);
-  const auto predicted = replay_session(session, 4, true_parameters(), options);
+  const auto predicted = replay_session(session, 4, demo_true_parameters(), options);
   double worst = 0.0;
   for (const PredictedCapture& capture : predicted) {
     const Eigen::MatrixXd real = read_frame_csv(session.dir / capture.frame, session.grid.ny, session.grid.nx);
-    double sum = 0.0;
-    int count = 0;
-    for (int iy = 0; iy < real.rows(); ++iy)
-      for (int ix = 0; ix < real.cols(); ++ix) {
-        const double a = capture.heights_mm(iy, ix), b = real(iy, ix);
-        if (std::isnan(a) || std::isnan(b)) continue;
-        sum += std::abs(a - b);
-        ++count;
-      }
-    EXPECT_GT(count, 0.95 * real.size()) << name << "/" << capture.frame;
-    worst = std::max(worst, sum / std::max(count, 1));
+    const CaptureError error = compare_capture(capture.heights_mm, real, 1.0);
+    EXPECT_GT(error.samples, 0.95 * real.size()) << name << "/" << capture.frame;
+    worst = std::max(worst, error.mae_mm());
   }
   std::cout << "  " << name << ": worst capture mean |diff| " << worst << " mm\n";
   return worst;
