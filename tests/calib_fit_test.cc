@@ -114,3 +114,44 @@ TEST(Diagnosis, BicPenalisesParametersAndNoiseFloorIsTheSensors) {
 
 }  // namespace
 }  // namespace hj
+
+namespace hj {
+namespace {
+
+TEST(ParameterCovariance, IndependentNoiseKeepsTheClassicIntervalCorrelatedMissesWidenIt) {
+  // y = a + b t over 40 captures of 50 samples; J = [1, t].
+  const int clusters = 40, per = 50, n = clusters * per;
+  Eigen::MatrixXd j(n, 2);
+  std::vector<long> rows = {0};
+  for (int c = 0; c < clusters; ++c) {
+    for (int s = 0; s < per; ++s) j.row(c * per + s) << 1.0, (c * per + s) / double(n);
+    rows.push_back(rows.back() + per);
+  }
+  // Independent noise (a fixed pseudo-random sequence): the sandwich agrees
+  // with the classic variance to within sampling error, and the classic one
+  // is kept where it is the larger.
+  Eigen::VectorXd noise(n);
+  unsigned state = 12345;
+  for (int i = 0; i < n; ++i) {
+    state = state * 1103515245u + 12345u;
+    noise[i] = ((state >> 8) % 2001) / 1000.0 - 1.0;
+  }
+  const Eigen::MatrixXd classic = parameter_covariance(j, noise, {});
+  const Eigen::MatrixXd iid = parameter_covariance(j, noise, rows);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_GE(iid(k, k), classic(k, k));
+    EXPECT_LT(iid(k, k), 2.0 * classic(k, k)) << k;
+  }
+  // The same spread, but each capture missed by one offset: 50 samples that
+  // say the same thing are one piece of evidence, so the variance grows
+  // about 50-fold.
+  Eigen::VectorXd shared(n);
+  for (int c = 0; c < clusters; ++c) shared.segment(c * per, per).setConstant(noise[c * per]);
+  const Eigen::MatrixXd wide = parameter_covariance(j, shared, rows);
+  const Eigen::MatrixXd narrow = parameter_covariance(j, shared, {});
+  EXPECT_GT(wide(0, 0), 10.0 * narrow(0, 0));
+  EXPECT_GT(wide(1, 1), 10.0 * narrow(1, 1));
+}
+
+}  // namespace
+}  // namespace hj

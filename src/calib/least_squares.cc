@@ -207,6 +207,17 @@ double total_sum_of_squares(const Dataset& dataset) {
   return n ? sum_sq - sum * sum / n : 0.0;
 }
 
+// The first residual row of each capture, in the order the residuals are
+// laid out (session by session, capture by capture, the measured samples),
+// and the total at the end.
+std::vector<long> capture_rows(const Dataset& dataset) {
+  std::vector<long> rows = {0};
+  for (const auto& session : dataset.sessions)
+    for (const auto& capture : session.captures)
+      rows.push_back(rows.back() + static_cast<long>((capture.heights_mm.array() == capture.heights_mm.array()).count()));
+  return rows;
+}
+
 }  // namespace
 
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
@@ -305,21 +316,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   const double sst = total_sum_of_squares(dataset);
   out.r2 = sst > 0.0 ? 1.0 - out.sum_sq_mm2 / sst : kNaN;
 
-  // Gauss-Newton covariance, inverted on the eigenvalues that are not
-  // negligible so that an unidentifiable direction shows as a huge error.
-  const double variance = out.sum_sq_mm2 / std::max<long>(out.residual_count - p, 1);
-  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(p, p);
-  if (p > 0) {
-    const Eigen::MatrixXd jtj = out.jacobian.transpose() * out.jacobian;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jtj);
-    const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
-    Eigen::VectorXd inverse(p);
-    for (int k = 0; k < p; ++k) {
-      const double e = eigen.eigenvalues()[k];
-      inverse[k] = e > 1e-14 * largest ? 1.0 / e : 1e30;
-    }
-    covariance = variance * eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
-  }
+  const Eigen::MatrixXd covariance = parameter_covariance(out.jacobian, out.residuals, capture_rows(dataset));
   for (int k = 0; k < p; ++k) {
     ParameterEstimate& e = out.estimates[out.active[k]];
     e.value = u[k] * scale_a[k];
@@ -332,6 +329,49 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
     e.loose = 1.96 * e.std_error > options.loose_relative_halfwidth * std::abs(e.value);
   }
   return out;
+}
+
+Eigen::MatrixXd parameter_covariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals,
+                                     const std::vector<long>& cluster_rows) {
+  const long n = residuals.size();
+  const int p = static_cast<int>(jacobian.cols());
+  if (p == 0) return {};
+  // Gauss-Newton covariance, inverted on the eigenvalues that are not
+  // negligible so that an unidentifiable direction shows as a huge error.
+  const double variance = residuals.squaredNorm() / std::max<long>(n - p, 1);
+  const Eigen::MatrixXd jtj = jacobian.transpose() * jacobian;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jtj);
+  const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+  Eigen::VectorXd inverse(p);
+  for (int k = 0; k < p; ++k) {
+    const double e = eigen.eigenvalues()[k];
+    inverse[k] = e > 1e-14 * largest ? 1.0 / e : 1e30;
+  }
+  const Eigen::MatrixXd bread = eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+  Eigen::MatrixXd covariance = variance * bread;
+  // The samples of one capture are not independent: where the model misses,
+  // it misses by a smooth surface over the whole frame. The classic
+  // covariance counts every sample as independent evidence and so can be
+  // far too narrow for a parameter that only a few captures inform
+  // (kappa_jam). The cluster-robust (sandwich) covariance treats each
+  // capture as one cluster; each parameter keeps the larger variance.
+  const long clusters = static_cast<long>(cluster_rows.size()) - 1;
+  if (clusters <= p || cluster_rows.front() != 0 || cluster_rows.back() != n) return covariance;
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
+  for (long c = 0; c < clusters; ++c) {
+    const long rows = cluster_rows[c + 1] - cluster_rows[c];
+    const Eigen::VectorXd g =
+        jacobian.middleRows(cluster_rows[c], rows).transpose() * residuals.segment(cluster_rows[c], rows);
+    meat += g * g.transpose();
+  }
+  const Eigen::MatrixXd robust = bread * meat * bread * (double(clusters) / double(clusters - p));
+  for (int k = 0; k < p; ++k)
+    if (robust(k, k) > covariance(k, k) && covariance(k, k) > 0.0) {
+      const double factor = std::sqrt(robust(k, k) / covariance(k, k));
+      covariance.row(k) *= factor;
+      covariance.col(k) *= factor;
+    }
+  return covariance;
 }
 
 }  // namespace hj

@@ -75,4 +75,14 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
                                   std::vector<int>* rows = nullptr);
 
+// The covariance (p x p) of the parameters behind `jacobian` (n x p) at
+// residuals r (n), whose rows form clusters [cluster_rows[c],
+// cluster_rows[c + 1]) (one per capture): per parameter the larger of the
+// Gauss-Newton variance s^2 (J^T J)^-1, s^2 = |r|^2 / (n - p), and the
+// cluster-robust (sandwich) one, (J^T J)^-1 (sum_c J_c^T r_c r_c^T J_c)
+// (J^T J)^-1 C / (C - p). Without clusters (fewer than p + 1, or rows not
+// covering 0..n) only the first.
+Eigen::MatrixXd parameter_covariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals,
+                                     const std::vector<long>& cluster_rows);
+
 }  // namespace hj
