@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "expect_error.h"
+#include "matrix_checks.h"
 
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
@@ -27,6 +28,8 @@
 
 namespace hj {
 namespace {
+
+using testing_support::expect_same;
 
 namespace fs = std::filesystem;
 using testing_support::expect_error;
@@ -77,16 +80,6 @@ void write_geotiff(const fs::path& file, const Eigen::MatrixXd& z, GDALDataType 
                            GDT_Float64, 0, 0),
             CE_None);
   GDALClose(ds);
-}
-
-void expect_same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  ASSERT_EQ(a.rows(), b.rows());
-  ASSERT_EQ(a.cols(), b.cols());
-  for (Eigen::Index r = 0; r < a.rows(); ++r)
-    for (Eigen::Index c = 0; c < a.cols(); ++c) {
-      if (std::isnan(a(r, c))) EXPECT_TRUE(std::isnan(b(r, c))) << r << "," << c;
-      else EXPECT_EQ(a(r, c), b(r, c)) << r << "," << c;
-    }
 }
 
 const double kLonLatGt[6] = {5.0, 0.5, 0.0, 50.0, 0.0, -0.25};  // 0.5 deg columns, 0.25 deg rows, NW corner 5E 50N

@@ -74,16 +74,6 @@ inline void write_ascii_stl(const std::filesystem::path& file, const std::vector
   out << "endsolid test\n";
 }
 
-// Equal, NaN where the other is NaN.
-inline void expect_same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  ASSERT_EQ(a.rows(), b.rows());
-  ASSERT_EQ(a.cols(), b.cols());
-  for (Eigen::Index k = 0; k < a.size(); ++k) {
-    if (std::isnan(a.data()[k])) EXPECT_TRUE(std::isnan(b.data()[k])) << k;
-    else EXPECT_NEAR(a.data()[k], b.data()[k], 1e-12) << k;
-  }
-}
-
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 inline double nan_max(const Eigen::MatrixXd& z) { return z.array().isNaN().select(-kInf, z.array()).maxCoeff(); }

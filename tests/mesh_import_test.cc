@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "matrix_checks.h"
 #include "mesh_fixtures.h"
 #include "shapes/resample.h"
 #include <limits>
@@ -38,7 +39,7 @@ TEST(MeshImport, HemisphereIsSqrtOneMinusRSquared) {
   const TopView raw = render_top_view(load_mesh_triangles(dir.path / "hemi.stl", options), 101);
   ASSERT_EQ(map.z.rows(), 101);
   ASSERT_EQ(map.z.cols(), 101);
-  expect_same(map.z, raw.z.array() - nan_min(raw.z));
+  expect_same(map.z, raw.z.array() - nan_min(raw.z), 1e-12);
   double worst = 0.0;
   for (Eigen::Index r = 0; r < raw.z.rows(); ++r)
     for (Eigen::Index c = 0; c < raw.z.cols(); ++c) {
@@ -98,7 +99,7 @@ TEST(MeshImport, UpAxisRotationsImportIdentically) {
     ImportOptions options;
     options.mesh_up_axis = c.axis;
     options.mesh_up_negative = c.negative;
-    expect_same(import_goal(file, options).z, reference.z);
+    expect_same(import_goal(file, options).z, reference.z, 1e-12);
   }
 }
 

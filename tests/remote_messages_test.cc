@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "expect_error.h"
+#include "hapticjam/v1/planning_service.pb.h"
 #include "remote_messages.h"
 
 namespace hj::cli {
@@ -104,6 +105,16 @@ TEST(RemoteMessages, ACaptureIsComparedWhereEachPointSits) {
   ASSERT_TRUE(snapshot_positions(s, sx, sy));
   EXPECT_EQ(sx(0, 1), 20.0);
   EXPECT_EQ(sy(0, 1), -2.0);
+}
+
+TEST(RemoteMessages, GoalHeightsAreRowMajorAndMustMatchTheMesh) {
+  v1::PreviewResponse r;
+  for (int k = 0; k < 6; ++k) r.add_goal_heights_mm(k);
+  const Eigen::MatrixXd g = goal_heights(r.goal_heights_mm(), 2, 3);
+  EXPECT_EQ(g(1, 0), 3.0);
+  EXPECT_EQ(g(0, 2), 2.0);
+  testing_support::expect_error<std::runtime_error>([&] { (void)goal_heights(r.goal_heights_mm(), 3, 3); },
+                                                    {"6 heights", "9 mesh points"});
 }
 
 TEST(RemoteMessages, SurfacesOfTheWrongSizeAreErrors) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "expect_error.h"
+#include "matrix_checks.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -26,6 +27,8 @@
 namespace hj {
 namespace {
 
+using testing_support::expect_same;
+
 using testing_support::ScratchDir;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -37,17 +40,6 @@ void write_text(const std::filesystem::path& file, const std::string& text) {
 }
 
 long nan_count(const Eigen::MatrixXd& z) { return z.array().isNaN().count(); }
-
-// Equal, NaN where the other is NaN.
-void expect_same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  ASSERT_EQ(a.rows(), b.rows());
-  ASSERT_EQ(a.cols(), b.cols());
-  for (Eigen::Index r = 0; r < a.rows(); ++r)
-    for (Eigen::Index c = 0; c < a.cols(); ++c) {
-      if (std::isnan(a(r, c))) EXPECT_TRUE(std::isnan(b(r, c))) << r << "," << c;
-      else EXPECT_EQ(a(r, c), b(r, c)) << r << "," << c;
-    }
-}
 
 using testing_support::expect_error;
 

@@ -90,6 +90,17 @@ Eigen::MatrixXd frame_heights(const v1::CaptureFrame& frame) {
   return out;
 }
 
+Eigen::MatrixXd goal_heights(const google::protobuf::RepeatedField<double>& heights_mm, Eigen::Index rows,
+                             Eigen::Index cols) {
+  if (heights_mm.size() != rows * cols)
+    throw std::runtime_error("server sent a goal of " + std::to_string(heights_mm.size()) + " heights for " +
+                             std::to_string(rows * cols) + " mesh points");
+  Eigen::MatrixXd out(rows, cols);
+  for (Eigen::Index i = 0; i < rows; ++i)
+    for (Eigen::Index j = 0; j < cols; ++j) out(i, j) = heights_mm[static_cast<int>(i * cols + j)];
+  return out;
+}
+
 bool snapshot_positions(const v1::SurfaceSnapshot& snapshot, Eigen::MatrixXd& x_mm, Eigen::MatrixXd& y_mm) {
   const int n = snapshot.heights_mm_size();
   if (n == 0 || snapshot.x_mm_size() != n || snapshot.y_mm_size() != n) return false;

@@ -23,6 +23,10 @@ hapticjam::v1::Plan plan_from_steps_json(const nlohmann::json& doc, const std::s
 // (point_rows x point_cols) heights in mm, row i along +y.
 // @throws std::runtime_error if the sizes disagree.
 Eigen::MatrixXd snapshot_heights(const hapticjam::v1::SurfaceSnapshot& snapshot);
+// The goal heights a plan or preview result carries (row-major, mm) as a
+// (rows x cols) matrix. @throws std::runtime_error if their count differs.
+Eigen::MatrixXd goal_heights(const google::protobuf::RepeatedField<double>& heights_mm, Eigen::Index rows,
+                             Eigen::Index cols);
 // The in-plane positions (mm) of the snapshot's points, same shape as its
 // heights; false if the server sent none.
 bool snapshot_positions(const hapticjam::v1::SurfaceSnapshot& snapshot, Eigen::MatrixXd& x_mm, Eigen::MatrixXd& y_mm);

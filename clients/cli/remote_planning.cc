@@ -108,12 +108,7 @@ int remote_plan(const RemotePlanArgs& args) {
   if (!have_result) throw std::runtime_error("the server ended the plan stream without a result");
 
   const Eigen::MatrixXd predicted = snapshot_heights(result.predicted());
-  Eigen::MatrixXd goal(predicted.rows(), predicted.cols());
-  if (result.goal_heights_mm_size() != predicted.size())
-    throw std::runtime_error("server sent a goal of " + std::to_string(result.goal_heights_mm_size()) + " heights for " +
-                             std::to_string(predicted.size()) + " mesh points");
-  for (int i = 0; i < goal.rows(); ++i)
-    for (int j = 0; j < goal.cols(); ++j) goal(i, j) = result.goal_heights_mm(i * goal.cols() + j);
+  const Eigen::MatrixXd goal = goal_heights(result.goal_heights_mm(), predicted.rows(), predicted.cols());
   write_frame_csv(out / "predicted.csv", predicted);
   Eigen::MatrixXd x_mm, y_mm;
   if (snapshot_positions(result.predicted(), x_mm, y_mm)) {
@@ -200,11 +195,9 @@ int remote_preview(const RemotePreviewArgs& args) {
   check(stub->Preview(connection.context(120).get(), request, &response), "Preview");
   if (!args.out.empty()) {
     const Eigen::MatrixXd predicted = snapshot_heights(response.predicted());
-    Eigen::MatrixXd goal(predicted.rows(), predicted.cols());
-    for (int k = 0; k < std::min<int>(goal.size(), response.goal_heights_mm_size()); ++k)
-      goal(k / goal.cols(), k % goal.cols()) = response.goal_heights_mm(k);
     write_frame_csv(fs::path(args.out) / "predicted.csv", predicted);
-    if (response.goal_heights_mm_size() == goal.size()) write_frame_csv(fs::path(args.out) / "goal.csv", goal);
+    write_frame_csv(fs::path(args.out) / "goal.csv",
+                    goal_heights(response.goal_heights_mm(), predicted.rows(), predicted.cols()));
   }
   if (args.json) {
     v1::PreviewResponse brief = response;
