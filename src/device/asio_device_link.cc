@@ -18,8 +18,8 @@
 #include <thread>
 
 #include "device/line_buffer.h"
-#include "device/make_device_link.h"
 #include "device/protocol.h"
+#include "device/status_mirror.h"
 
 namespace hj::device {
 
@@ -447,22 +447,7 @@ void AsioDeviceLink::execute(const Action& action, std::chrono::milliseconds tim
   impl_->request(command, timeout);
   // Acknowledged: mirror it.
   std::lock_guard lock(impl_->mutex);
-  DeviceStatus& s = impl_->status;
-  switch (action.op) {
-    case Action::Op::kSetPressure: s.pressure_pa = action.pressure_pa; break;
-    case Action::Op::kJam:
-    case Action::Op::kUnjam: {
-      const long i = static_cast<long>(action.a) * s.cols + action.b;
-      if (i >= 0 && i < static_cast<long>(s.cell_jammed.size())) s.cell_jammed[i] = action.op == Action::Op::kJam;
-      break;
-    }
-    case Action::Op::kPin:
-    case Action::Op::kUnpin: {
-      const long i = static_cast<long>(action.a) * (s.cols + 1) + action.b;
-      if (i >= 0 && i < static_cast<long>(s.node_pinned.size())) s.node_pinned[i] = action.op == Action::Op::kPin;
-      break;
-    }
-  }
+  mirror_action(impl_->status, action);
 }
 
 Capture AsioDeviceLink::capture(std::chrono::milliseconds timeout) {
@@ -481,10 +466,7 @@ Capture AsioDeviceLink::capture(std::chrono::milliseconds timeout) {
 void AsioDeviceLink::vent(std::chrono::milliseconds timeout) {
   impl_->request("vent", timeout);
   std::lock_guard lock(impl_->mutex);
-  DeviceStatus& s = impl_->status;
-  s.pressure_pa = 0.0;
-  std::fill(s.cell_jammed.begin(), s.cell_jammed.end(), 0);
-  std::fill(s.node_pinned.begin(), s.node_pinned.end(), 0);
+  mirror_vent(impl_->status);
 }
 
 DeviceStatus AsioDeviceLink::status() const {
@@ -516,10 +498,6 @@ void AsioDeviceLink::ping(std::chrono::milliseconds timeout) { impl_->request("p
 
 std::string AsioDeviceLink::send_raw(const std::string& command, std::chrono::milliseconds timeout) {
   return impl_->request(command, timeout).text;
-}
-
-std::unique_ptr<DeviceLink> make_device_link(const std::string& endpoint, LinkOptions options) {
-  return std::make_unique<AsioDeviceLink>(parse_endpoint(endpoint), options);
 }
 
 }  // namespace hj::device
