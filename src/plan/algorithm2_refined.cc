@@ -31,10 +31,9 @@ constexpr double kEndPressureFactors[] = {4.0, 3.0, 2.0, 1.5, 1.25, 1.1, 1.02};
 // and, unless jam_below_levelling, no jam while the pressure is below the
 // levelling pressure.
 PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_max,
-                       const std::function<bool()>& cancelled) {
-  SimulatorOptions options = request.simulator;
-  if (cancelled) options.interrupted = cancelled;  // stops a long settle midway (SettleInterrupted)
-  Simulator sim(request.geometry, request.params, options);
+                       const PlanCallbacks& callbacks) {
+  const std::function<bool()>& cancelled = callbacks.cancelled;
+  Simulator sim(request.geometry, request.params, simulator_options(request, callbacks));
   const Mesh& mesh = sim.mesh();
   const double p_level = request.params.levelling_pressure_pa(mesh);
   Eigen::Matrix3Xd goal_x = mesh.rest_positions();
@@ -149,7 +148,7 @@ PlanResult Algorithm2Refined::plan(const PlanRequest& request, const PlanCallbac
     }
     PlanResult candidate;
     try {
-      candidate = run_variant(request, v, p_max, callbacks.cancelled);
+      candidate = run_variant(request, v, p_max, callbacks);
     } catch (const PlanCancelled&) {
       throw;
     } catch (const SettleInterrupted&) {
