@@ -16,6 +16,9 @@ struct SettleReport {
   bool converged = false;
   int iterations = 0;        // Newton steps or time steps
   int restarts = 0;          // moves off a saddle or singular state
+  // Ended on an equilibrium with a weakly unstable mode that a push did not
+  // leave within StaticSolverOptions::push_iterations.
+  bool marginal = false;
   double residual_n = 0.0;   // largest |F| on a free point at the end, N
   double seconds = 0.0;      // wall time
 };

@@ -1,10 +1,12 @@
 #include "sim/simulator.h"
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 
 #include "sim/effect_registry.h"
 #include "sim/jamming_springs.h"
+#include "sim/levelling_crossing.h"
 
 namespace hj {
 
@@ -67,8 +69,13 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
   action.validate(mesh(), params());
   const DeviceState before = state_;
   const Mesh& m = mesh();
+  std::optional<Eigen::Matrix3Xd> predicted;
   switch (action.op) {
     case Action::Op::kSetPressure:
+      if (!start && options_.solver == SolverKind::kStatic) {
+        predicted = levelling_crossing_start(model_, state_, action.pressure_pa);
+        if (predicted) start = &*predicted;
+      }
       state_.pressure_pa = action.pressure_pa;
       break;
     case Action::Op::kJam:

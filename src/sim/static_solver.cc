@@ -1,7 +1,5 @@
 #include "sim/static_solver.h"
 
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseLU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "sim/divergence_mode.h"
 #include "sim/shifted_solver.h"
 #include "sim/stiffness_matrix.h"
 
@@ -27,7 +26,9 @@ void StaticSolverOptions::validate() const {
   if (fast_iterations < 0) bad("fast_iterations", "must be >= 0");
   if (!(initial_shift >= 0.0) || !std::isfinite(initial_shift)) bad("initial_shift", "(x spring_k) must be >= 0");
   if (!(max_step_fraction > 0.0)) bad("max_step_fraction", "(x h) must be > 0");
+  if (!(fast_step_fraction > 0.0)) bad("fast_step_fraction", "(x h) must be > 0");
   if (max_restarts < 0) bad("max_restarts", "must be >= 0");
+  if (push_iterations < 1) bad("push_iterations", "must be at least 1");
 }
 
 namespace {
@@ -39,35 +40,6 @@ void add_shift(StiffnessMatrix& k, double mu) {
   if (mu == 0.0) return;
   const Eigen::Matrix3d shift = mu * Eigen::Matrix3d::Identity();
   for (int p : k.free_points()) k.add(p, p, shift);
-}
-
-// The eigenvector of sym(K) whose eigenvalue is nearest zero, if that
-// eigenvalue is not clearly positive; an empty vector when K is stable.
-Eigen::VectorXd unstable_mode(const StiffnessMatrix& k) {
-  const Eigen::SparseMatrix<double> sym = 0.5 * (k.matrix() + Eigen::SparseMatrix<double>(k.matrix().transpose()));
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(sym);
-  if (ldlt.info() == Eigen::Success) {
-    const Eigen::VectorXd d = ldlt.vectorD();
-    // Without pivoting, the signs of D are the signs of the eigenvalues
-    // (Sylvester's law of inertia).
-    if (d.minCoeff() > 1e-12 * d.cwiseAbs().maxCoeff()) return {};
-  }
-  // Inverse iteration, shifted slightly so a singular K still factors.
-  const double scale = sym.diagonal().cwiseAbs().maxCoeff();
-  Eigen::SparseMatrix<double> shifted = sym;
-  for (int i = 0; i < shifted.rows(); ++i) shifted.coeffRef(i, i) += 1e-9 * scale;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(shifted);
-  if (lu.info() != Eigen::Success) return {};
-  Eigen::VectorXd v = Eigen::VectorXd::Ones(sym.rows());
-  for (int i = 0; i < v.size(); i += 3) v(i) = v(i + 1) = 0.0;  // start out of plane
-  for (int it = 0; it < 40; ++it) {
-    Eigen::VectorXd next = lu.solve(v);
-    if (!next.allFinite() || next.norm() == 0.0) return {};
-    v = next.normalized();
-  }
-  const double lambda = v.dot(sym * v);
-  if (lambda > 1e-9 * scale) return {};
-  return v;
 }
 
 // How the shift mu follows the iterations.
@@ -88,22 +60,36 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
                       const std::vector<char>& fixed, const StaticSolverOptions& options, StepControl control,
                       int max_iterations, double mu0, SettleReport& report) {
   const Mesh& mesh = model.mesh();
-  const double max_step = options.max_step_fraction * mesh.spacing();
+  const double max_step =
+      (control == StepControl::kDisplacement ? options.fast_step_fraction : options.max_step_fraction) * mesh.spacing();
   Eigen::Matrix3Xd f, f_trial;
   model.forces(state, state.x, f);
   Eigen::VectorXd residual = k.gather(f);
   double mu = mu0;
+  // The equilibrium last pushed off, and the iteration of the push.
+  Eigen::Matrix3Xd pushed_from;
+  int pushed_at = -1;
+  // A push that has not led to another equilibrium within its budget was
+  // along a mode too weak to matter: settle for the equilibrium it left.
+  auto settle_for_pushed_from = [&] {
+    state.x = pushed_from;
+    model.forces(state, state.x, f);
+    report.residual_n = max_free_force(f, fixed);
+    report.converged = report.marginal = true;
+  };
   for (int it = 0; it < max_iterations; ++it, ++report.iterations) {
     if (options.interrupted && options.interrupted()) throw SettleInterrupted();
+    if (pushed_at >= 0 && it - pushed_at > options.push_iterations) return settle_for_pushed_from();
     report.residual_n = max_free_force(f, fixed);
     if (report.residual_n < options.force_tolerance_n) {
+      pushed_at = -1;
       if (!options.check_stability || report.restarts >= options.max_restarts) {
         report.converged = true;
         return;
       }
       k.set_zero();
       model.add_stiffness(state, state.x, k);
-      const Eigen::VectorXd mode = unstable_mode(k);
+      const Eigen::VectorXd mode = divergence_mode(k.matrix());
       if (mode.size() == 0) {
         report.converged = true;
         return;
@@ -113,6 +99,8 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       Eigen::Index r = 0, c = 0;
       const double largest = push.cwiseAbs().maxCoeff(&r, &c);
       if (push(r, c) < 0) push = -push;  // a deterministic choice of side
+      pushed_from = state.x;
+      pushed_at = it;
       state.x += (0.05 * mesh.spacing() / largest) * push;
       model.forces(state, state.x, f);
       residual = k.gather(f);
@@ -163,6 +151,7 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
     residual = residual_trial;
     if (mu < 1e-10 * mu0) mu = 0.0;
   }
+  if (pushed_at >= 0) return settle_for_pushed_from();
   report.residual_n = max_free_force(f, fixed);
 }
 

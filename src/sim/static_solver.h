@@ -25,7 +25,14 @@ struct StaticSolverOptions {
   int fast_iterations = 40;          // budget of the fast one, tried first (0: skip)
   double initial_shift = 0.1;        // mu at the start, in units of spring_k
   double max_step_fraction = 1.0;    // largest move of a point per step, in h
+  // The same for the fast control: it is abandoned when it fails, so it can
+  // stride further (9 x 12 from a mirrored start: 24 steps at 2 h, 75 at 1 h).
+  double fast_step_fraction = 2.0;
   int max_restarts = 6;              // pushes off unstable equilibria
+  // Iterations a push may take to reach another equilibrium; past them the
+  // settle ends on the one it left, reported marginal (a slowly diverging
+  // mode, e.g. the shear mechanisms of a large dome, see unstable_mode).
+  int push_iterations = 20;
   bool check_stability = true;
   // Polled every step; true throws SettleInterrupted (state left mid-way).
   std::function<bool()> interrupted;

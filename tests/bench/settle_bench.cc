@@ -55,11 +55,25 @@ void BM_SettleOneActionAfter2kPa(benchmark::State& state) {
       Action::set_pressure(1000.0));
 }
 
+// A planner-sized step: jam the centre cell at 2 kPa, then 1.9 kPa.
+void BM_SettleCentreJamThenStep(benchmark::State& state) {
+  const int rows = static_cast<int>(state.range(0)), cols = static_cast<int>(state.range(1));
+  time_one_action(
+      state,
+      [&](hj::Simulator& sim) {
+        sim.apply(Action::set_pressure(2000.0));
+        sim.apply(Action::jam(rows / 2, cols / 2));
+      },
+      Action::set_pressure(1900.0));
+}
+
 BENCHMARK(BM_SettleRestTo2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_SettleCentreJamThenStep)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
 // The slow ones, run by name: 9 x 12 explicit, p = 10, and the 9 x 12 jammed
 // step (2 -> 1 kPa), which the static solver does not yet settle (issue 2).
 BENCHMARK(BM_SettleRestTo2kPa)->Name("Slow/BM_SettleRestTo2kPa")->Args({9, 12, 4, 1})->Args({9, 12, 10, 0})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Name("Slow/BM_SettleOneActionAfter2kPa")->Args({9, 12, 4, 0})->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_SettleCentreJamThenStep)->Name("Slow/BM_SettleCentreJamThenStep")->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
