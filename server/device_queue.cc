@@ -78,7 +78,7 @@ void DeviceQueue::connection_changed(bool connected) {
         const std::string why = "the device link dropped during the job";
         abort_running(v1::JOB_STATE_INTERRUPTED, why);
         pause("job " + std::to_string(running_id_) + " was interrupted: " + why +
-              "; the device is vented on reconnect and an admin must resume the queue");
+              "; the device is vented on reconnect and an operator must resume the queue (ResumeQueue)");
       }
     }
     log_event("device_link", {{"connected", connected}});
@@ -179,7 +179,7 @@ void DeviceQueue::run_job(std::unique_lock<std::mutex>& lock, std::int64_t id) {
     need_vent_ = true;
     if (fault) {
       abort_running(v1::JOB_STATE_INTERRUPTED, "device: " + error);
-      if (!store_.paused()) pause("job " + std::to_string(id) + " was interrupted: " + error + "; an admin must resume the queue");
+      if (!store_.paused()) pause("job " + std::to_string(id) + " was interrupted: " + error + "; an operator must resume the queue (ResumeQueue)");
     } else {
       abort_running(v1::JOB_STATE_FAILED, "device refused: " + error);
     }
@@ -342,7 +342,7 @@ v1::DeviceStatus DeviceQueue::emergency_stop(const Caller& caller, const std::st
     const std::string why = "emergency stop by " + caller.name + (reason.empty() ? "" : ": " + reason);
     emergency_stopped_ = true;
     abort_running(v1::JOB_STATE_INTERRUPTED, why);
-    pause(why + "; an admin must resume the queue");
+    pause(why + "; an operator must resume the queue (ResumeQueue)");
     changed();
   }
   // Straight to the link, not through the runner: it may be inside a step.
