@@ -35,17 +35,17 @@ std::string html_escape(const std::string& text) {
 
 std::string svg_plot(const Plot& plot, int width, int height) {
   const double left = 64, right = 160, top = 30, bottom = 48;
-  double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo, y_hi = -x_lo;
+  double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo, y_hi = -x_lo, y_data_lo = x_lo;
   for (const auto& s : plot.series)
     for (size_t i = 0; i < s.x.size(); ++i) {
       x_lo = std::min(x_lo, s.x[i]);
       x_hi = std::max(x_hi, s.x[i]);
-      if (std::isfinite(s.y[i])) y_hi = std::max(y_hi, s.y[i]);
+      if (std::isfinite(s.y[i])) y_hi = std::max(y_hi, s.y[i]), y_data_lo = std::min(y_data_lo, s.y[i]);
     }
   if (!plot.reference_label.empty()) y_hi = std::max(y_hi, plot.reference_y);
   if (!std::isfinite(x_lo)) x_lo = 0, x_hi = 1, y_hi = 1;
   if (x_hi <= x_lo) x_hi = x_lo + 1;
-  const double y_lo = plot.y_min;
+  const double y_lo = plot.y_min.value_or(std::isfinite(y_data_lo) ? y_data_lo : 0.0);
   y_hi = y_lo + (y_hi - y_lo) * 1.1;
   if (y_hi <= y_lo) y_hi = y_lo + 1;
   const double pad = plot.x_ticks.empty() ? 0.0 : 0.5;
@@ -83,18 +83,23 @@ std::string svg_plot(const Plot& plot, int width, int height) {
     svg += "<text x='" + fmt(width - right + 4) + "' y='" + fmt(py(plot.reference_y) + 4) + "' fill='grey'>" +
            html_escape(plot.reference_label) + "</text>";
   }
+  for (const PlotFit& f : plot.fits)
+    svg += "<line x1='" + fmt(px(x_lo)) + "' y1='" + fmt(py(f.slope * x_lo + f.intercept)) + "' x2='" + fmt(px(x_hi)) +
+           "' y2='" + fmt(py(f.slope * x_hi + f.intercept)) + "' stroke='black' stroke-dasharray='7,5'><title>" +
+           html_escape(f.label) + "</title></line>";
   int legend = 0;
   for (const auto& s : plot.series) {
+    const std::string colour = series_colour(s, static_cast<size_t>(legend));
     std::string points;
     for (size_t i = 0; i < s.x.size(); ++i)
       if (std::isfinite(s.y[i])) points += fmt(px(s.x[i])) + "," + fmt(py(s.y[i])) + " ";
-    if (s.lines) svg += "<polyline fill='none' stroke='" + s.colour + "' stroke-width='2' points='" + points + "'/>";
+    if (s.lines) svg += "<polyline fill='none' stroke='" + colour + "' stroke-width='2' points='" + points + "'/>";
     if (s.markers)
       for (size_t i = 0; i < s.x.size(); ++i)
         if (std::isfinite(s.y[i]))
-          svg += "<circle cx='" + fmt(px(s.x[i])) + "' cy='" + fmt(py(s.y[i])) + "' r='3' fill='" + s.colour + "'/>";
+          svg += "<circle cx='" + fmt(px(s.x[i])) + "' cy='" + fmt(py(s.y[i])) + "' r='3' fill='" + colour + "'/>";
     const double ly = top + 14.0 * legend++;
-    svg += "<rect x='" + fmt(width - right + 4) + "' y='" + fmt(ly - 8) + "' width='10' height='10' fill='" + s.colour +
+    svg += "<rect x='" + fmt(width - right + 4) + "' y='" + fmt(ly - 8) + "' width='10' height='10' fill='" + colour +
            "'/><text x='" + fmt(width - right + 18) + "' y='" + fmt(ly + 1) + "'>" + html_escape(s.name) + "</text>";
   }
   return svg + "</svg>";

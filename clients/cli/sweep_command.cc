@@ -12,7 +12,7 @@
 
 #include "args.h"
 #include "plan/sweep.h"
-#include "plot.h"
+#include "plot_png.h"
 #include "progress.h"
 #include "shapes/goal_importer.h"
 #include "shapes/resample.h"
@@ -188,32 +188,35 @@ int sweep(const SweepArgs& args) {
   }
 
   // Fig. 11: correlation against the number of cells, one line per goal.
-  std::vector<PlotSeries> by_goal;
+  Plot fig11{"Correlation against array size (cf. Fig. 11)", "number of cells", "correlation (Eq. 12)"};
   std::map<std::string, std::size_t> index;
   for (const auto& r : rows) {
-    if (!index.count(r.goal)) index[r.goal] = by_goal.size(), by_goal.push_back({r.goal, {}, true});
-    if (r.correlation) by_goal[index[r.goal]].points.push_back({double(r.cells()), *r.correlation});
+    if (!index.count(r.goal)) index[r.goal] = fig11.series.size(), fig11.series.push_back({r.goal});
+    if (r.correlation) {
+      fig11.series[index[r.goal]].x.push_back(double(r.cells()));
+      fig11.series[index[r.goal]].y.push_back(*r.correlation);
+    }
   }
-  write_plot_png(out / "fig11_correlation_vs_cells.png", "Correlation against array size (cf. Fig. 11)",
-                 "number of cells", "correlation (Eq. 12)", by_goal);
+  write_plot_png(out / "fig11_correlation_vs_cells.png", fig11);
   // Fig. 13: correlation against the Laplace mean (alpha_L = 1/3), with the fit.
   std::size_t a13 = 0;
   for (std::size_t k = 0; k < alphas.size(); ++k)
     if (std::abs(alphas[k] - 1.0 / 3.0) < 1e-12) a13 = k;
-  std::vector<PlotSeries> scatter = by_goal;
-  for (auto& s : scatter) s.points.clear(), s.lines = false;
+  Plot fig13{"Correlation against the Laplace mean (cf. Fig. 13)", "Laplace mean of the goal on the mesh",
+             "correlation (Eq. 12)"};
+  for (const auto& s : fig11.series) fig13.series.push_back({s.name, {}, {}, "", false});
   for (const auto& r : rows)
-    if (r.correlation && a13 < r.laplace_mean.size())
-      scatter[index[r.goal]].points.push_back({r.laplace_mean[a13], *r.correlation});
-  std::vector<PlotLine> fit_lines;
+    if (r.correlation && a13 < r.laplace_mean.size()) {
+      fig13.series[index[r.goal]].x.push_back(r.laplace_mean[a13]);
+      fig13.series[index[r.goal]].y.push_back(*r.correlation);
+    }
   if (a13 < t2.size() && t2[a13].fit) {
     char label[96];
     std::snprintf(label, sizeof label, "fit: r = %.3f L %+.3f, r^2 = %.3f (alpha_L = %.3g)", t2[a13].fit->slope,
                   t2[a13].fit->intercept, t2[a13].fit->r2, alphas[a13]);
-    fit_lines.push_back({t2[a13].fit->slope, t2[a13].fit->intercept, label});
+    fig13.fits.push_back({t2[a13].fit->slope, t2[a13].fit->intercept, label});
   }
-  write_plot_png(out / "fig13_correlation_vs_laplace.png", "Correlation against the Laplace mean (cf. Fig. 13)",
-                 "Laplace mean of the goal on the mesh", "correlation (Eq. 12)", scatter, fit_lines);
+  write_plot_png(out / "fig13_correlation_vs_laplace.png", fig13);
 
   // The table on stdout.
   std::printf("%-28s %5s %5s %6s %11s %9s %8s  %s\n", "goal", "rows", "cols", "cells", "correlation", "laplace", "seconds", "status");
