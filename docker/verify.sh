@@ -119,7 +119,7 @@ compose up -d >"$OUT/compose-up.log" 2>&1 || { cat "$OUT/compose-up.log"; fail "
 wait_serving
 echo "health: PlanningService $(health hapticjam.v1.PlanningService), DeviceService $(health hapticjam.v1.DeviceService)"
 
-step "auth: no token and a preview token are refused"
+step "auth: no token is refused; the emulator is connected"
 set +e
 "$HJ" remote status --server $SERVER >/dev/null 2>"$OUT/no-token.err"; code=$?
 set -e
@@ -134,7 +134,12 @@ step "a streamed plan of $DEM"
 [ -f "$OUT/plan/plan.json" ] || fail "no plan.json"
 ls "$OUT/plan" | grep -q snapshot || fail "no snapshots were streamed"
 
-step "submit to the emulated device, capture, compare"
+step "submit: a preview token is refused; the operator's job runs on the emulated device, capture, compare"
+set +e
+"$HJ" remote submit "$OUT/plan/plan.json" --server $SERVER --token "$VIEWER" >/dev/null 2>"$OUT/wrong-role.err"; code=$?
+set -e
+[ $code -eq 17 ] || fail "remote submit with a preview token: exit $code, expected 17 (PERMISSION_DENIED)"
+echo "preview token submitting: exit 17 PERMISSION_DENIED"
 "$HJ" remote submit "$OUT/plan/plan.json" --capture --wait --out "$OUT/device" --name "verify: volcano" \
   --server $SERVER --token "$OPERATOR" | tee "$OUT/submit.txt"
 "$HJ" remote watch --once --recent 3 --server $SERVER --token "$OPERATOR" | tee "$OUT/watch.txt"
