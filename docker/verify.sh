@@ -36,8 +36,10 @@ if ! podman image exists "$BASE" && ! timeout 60 podman pull -q "$BASE"; then
   command -v debootstrap >/dev/null || fail "no debootstrap (apt-get install debootstrap)"
   rootfs=$(mktemp -d)
   debootstrap --variant=minbase bookworm "$rootfs" http://deb.debian.org/debian >"$OUT/debootstrap.log"
-  # The sources of the official image (bookworm, -updates, -security), no lists.
-  rm -f "$rootfs/etc/apt/sources.list" && rm -rf "$rootfs"/var/lib/apt/lists/*
+  # The sources of the official image (bookworm, -updates, -security); no
+  # package lists, no downloaded packages.
+  rm -f "$rootfs/etc/apt/sources.list"
+  rm -rf "$rootfs"/var/lib/apt/lists/* "$rootfs"/var/cache/apt/archives/*.deb "$rootfs"/var/cache/apt/*.bin
   cat >"$rootfs/etc/apt/sources.list.d/debian.sources" <<'EOF'
 Types: deb
 URIs: http://deb.debian.org/debian
