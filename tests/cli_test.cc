@@ -102,6 +102,32 @@ TEST(Cli, TooFewSegmentsIsAUsageError) {
   EXPECT_NE(read_text(dir.path / "stderr.txt").find("--segments"), std::string::npos);
 }
 
+// An output folder the demo cannot write its session into (in a container: a
+// volume owned by another user) is named as such. A folder in the way of
+// session.json fails the same write even for root, who ignores permissions.
+TEST(Cli, DemoNamesTheSessionFileItCannotWrite) {
+  ScratchDir dir;
+  const fs::path out = dir.path / "out";
+  fs::create_directories(out / "session.json");
+  EXPECT_EQ(run_cli("demo --out " + quoted(out), dir.path), 1);
+  const std::string err = read_text(dir.path / "stderr.txt");
+  EXPECT_NE(err.find((out / "session.json").string() + ": cannot write the demo session (Is a directory)"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("cannot open session file"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(out / "frames"));
+}
+
+// An --out below a regular file cannot be created; the message names it.
+TEST(Cli, DemoNamesAnOutputFolderItCannotCreate) {
+  ScratchDir dir;
+  std::ofstream(dir.path / "file") << "x";
+  const fs::path out = dir.path / "file" / "out";
+  EXPECT_EQ(run_cli("demo --out " + quoted(out), dir.path), 1);
+  const std::string err = read_text(dir.path / "stderr.txt");
+  EXPECT_NE(err.find(out.string() + ": cannot create the output folder"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace hj
 

@@ -1,8 +1,10 @@
 #include "simulate_command.h"
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -127,9 +129,19 @@ int run_demo(const std::vector<std::string>& args) {
     return 2;
   }
   // The output folder becomes a complete session: the steps and the frames.
-  std::filesystem::create_directories(parsed.out);
+  // A folder it cannot write to (a container's volume owned by another user)
+  // is named here, not later as a session file that cannot be read.
+  std::error_code ec;
+  std::filesystem::create_directories(parsed.out, ec);
+  if (ec) throw std::runtime_error(parsed.out + ": cannot create the output folder: " + ec.message());
   parsed.session = (std::filesystem::path(parsed.out) / "session.json").string();
-  std::ofstream(parsed.session) << kDemoSessionJson;
+  std::ofstream session_file(parsed.session);
+  const std::string open_error = session_file ? "" : std::string(" (") + std::strerror(errno) + ")";
+  session_file << kDemoSessionJson;
+  session_file.close();
+  if (!session_file)
+    throw std::runtime_error(parsed.session + ": cannot write the demo session" + open_error +
+                             ": is --out writable by this user?");
   return simulate(parsed);
 }
 
