@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "metrics/correlation.h"
 #include "sim/surface_measures.h"
@@ -11,7 +12,7 @@ namespace hj {
 namespace {
 
 // End pressures tried after the descent, as multiples of the levelling
-// pressure: below it the cells between pins sag, above it they bulge.
+// pressure, in rising order.
 constexpr double kEndPressureFactors[] = {0.0, 0.5, 0.8, 0.9, 1.02, 1.1, 1.25, 1.5, 2.0};
 
 }  // namespace
@@ -129,17 +130,29 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
     if (result.steps.size() > steps_before + 1) step = options_.decrement_pa;  // pinned or jammed: full steps again
   }
 
-  // End pressure: with the pins and jams set, the best of a few pressures
-  // up to twice levelling (cells between pins sag below it, bulge above).
+  // End pressure: with the pins and jams set, cells between pins sag below
+  // levelling and bulge above it. From the pressure reached, step through
+  // the end pressures downwards while the correlation improves, else
+  // upwards while it improves (a hill climb), and end at the best.
   const auto score = [&] {
     return correlate(request.goal_mm, point_heights(mesh, sim.state().x) * 1000.0).value.value_or(-INFINITY);
   };
-  double best_pressure = pressure, best_r = score();
+  std::vector<double> below, above;
   for (double f : kEndPressureFactors) {
     const double p = f * p_level;
-    if (p == pressure || p > p_max) continue;
-    apply(Action::set_pressure(p));
-    if (const double r = score(); r > best_r) best_r = r, best_pressure = p;
+    if (p < pressure) below.insert(below.begin(), p);
+    else if (p > pressure && p <= p_max) above.push_back(p);
+  }
+  double best_pressure = pressure, best_r = score();
+  for (const std::vector<double>* direction : {&below, &above}) {
+    const double from = best_pressure;
+    for (double p : *direction) {
+      apply(Action::set_pressure(p));
+      const double r = score();
+      if (!(r > best_r)) break;
+      best_r = r, best_pressure = p;
+    }
+    if (best_pressure != from) break;
   }
   if (sim.state().pressure_pa != best_pressure) apply(Action::set_pressure(best_pressure));
   progress(1.0, best_pressure, "done");
