@@ -17,7 +17,10 @@ namespace hj {
 
 struct FromAboveOptions {
   double decrement_pa = 50.0;     // the downward step, halved on overshoot
-  double min_step_pa = 1.0;       // bisection stops here
+  // Bisection stops here. Close to levelling the height goes as the cube
+  // root of the net load, so a node whose goal is nearly flat can land
+  // further below it than the tolerance.
+  double min_step_pa = 1.0;
   // A pin lands within max(pin_tolerance_mm, pin_tolerance_fraction * goal relief).
   double pin_tolerance_mm = 0.5;
   double pin_tolerance_fraction = 0.02;
