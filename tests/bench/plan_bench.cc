@@ -19,7 +19,23 @@ void BM_PlanVolcanoDem(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PlanVolcanoDem)->Args({3, 4})->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_PlanVolcanoDem)->Name("Slow/BM_PlanVolcanoDem")->Args({9, 12})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_PlanVolcanoDem)->Name("Slow/BM_PlanVolcanoDem")->Args({6, 8})->Args({9, 12})->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// The from-above planner (src/plan/from_above.h) on the same DEM.
+void BM_PlanVolcanoDemFromAbove(benchmark::State& state) {
+  const hj::ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038, 4};
+  const hj::HeightMap goal = hj::import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
+  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}};
+  const auto planner = hj::make_planner("from-above");
+  for (auto _ : state) benchmark::DoNotOptimize(planner->plan(request).steps.size());
+}
+BENCHMARK(BM_PlanVolcanoDemFromAbove)->Args({3, 4})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_PlanVolcanoDemFromAbove)
+    ->Name("Slow/BM_PlanVolcanoDemFromAbove")
+    ->Args({6, 8})
+    ->Args({9, 12})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 }  // namespace
 

@@ -1,0 +1,167 @@
+#include "plan/from_above.h"
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "metrics/correlation.h"
+#include "sim/surface_measures.h"
+
+namespace hj {
+
+namespace {
+
+// End pressures tried after the descent, as multiples of the levelling
+// pressure, in rising order.
+constexpr double kEndPressureFactors[] = {0.0, 0.5, 0.8, 0.9, 1.02, 1.1, 1.25, 1.5, 2.0};
+
+}  // namespace
+
+void FromAboveOptions::validate() const {
+  auto positive = [](double v, const char* field) {
+    if (!(v > 0.0) || !std::isfinite(v)) throw std::invalid_argument(std::string("FromAboveOptions.") + field + " must be > 0");
+  };
+  positive(decrement_pa, "decrement_pa (Pa)");
+  positive(min_step_pa, "min_step_pa (Pa)");
+  if (!(pin_tolerance_mm >= 0.0) || !std::isfinite(pin_tolerance_mm))
+    throw std::invalid_argument("FromAboveOptions.pin_tolerance_mm (mm) must be >= 0");
+  if (!(pin_tolerance_fraction >= 0.0 && pin_tolerance_fraction < 1.0))
+    throw std::invalid_argument("FromAboveOptions.pin_tolerance_fraction must lie in [0, 1)");
+  if (!(max_pressure_pa >= 0.0) || !std::isfinite(max_pressure_pa))
+    throw std::invalid_argument("FromAboveOptions.max_pressure_pa (Pa) must be >= 0 (0: the device maximum)");
+}
+
+FromAbove::FromAbove(FromAboveOptions options) : options_(options) { options_.validate(); }
+
+PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& callbacks) const {
+  validate_plan_request(request, Mesh(request.geometry));
+  auto start = [&] {
+    try {
+      return Simulator(request.geometry, request.params, simulator_options(request, callbacks));
+    } catch (const SettleInterrupted&) {
+      throw PlanCancelled();
+    }
+  };
+  Simulator sim = start();
+  const Mesh& mesh = sim.mesh();
+  const double p_max = options_.max_pressure_pa > 0.0 ? std::min(options_.max_pressure_pa, request.params.max_pressure_pa)
+                                                      : request.params.max_pressure_pa;
+  const double p_level = request.params.levelling_pressure_pa(mesh);
+  // Below levelling the cells between pinned nodes sag, which brings the
+  // nodes around a pinned summit down to goals under the straight line from
+  // it to the clamped edge, so the descent goes on down to no pressure.
+  const double p_floor = 0.0;
+
+  // The goal as a surface on the mesh, for its node heights and curvatures.
+  Eigen::Matrix3Xd goal_x = mesh.rest_positions();
+  for (int i = 0; i < mesh.point_rows(); ++i)
+    for (int j = 0; j < mesh.point_cols(); ++j) goal_x(2, mesh.index(i, j)) = request.goal_mm(i, j) / 1000.0;
+  const Eigen::MatrixXd goal_curvature = cell_curvatures(mesh, goal_x);
+  const double tolerance_m =
+      std::max(options_.pin_tolerance_mm,
+               options_.pin_tolerance_fraction * (request.goal_mm.maxCoeff() - request.goal_mm.minCoeff())) /
+      1000.0;
+
+  PlanResult result;
+  auto apply = [&](const Action& action) {
+    if (callbacks.cancelled && callbacks.cancelled()) throw PlanCancelled();
+    try {
+      sim.apply(action);
+    } catch (const SettleInterrupted&) {
+      throw PlanCancelled();
+    }
+    result.steps.push_back(action);
+    if (callbacks.snapshot) callbacks.snapshot(sim.state());
+  };
+  auto progress = [&](double fraction, double pressure_pa, const char* phase) {
+    if (!callbacks.progress) return;
+    char what[64];
+    std::snprintf(what, sizeof what, "%s, pressure %.3f kPa", phase, pressure_pa / 1000.0);
+    callbacks.progress(fraction, what);
+  };
+  const auto free_node_height_error = [&](auto&& predicate) {
+    for (int a = 1; a < mesh.rows(); ++a)
+      for (int b = 1; b < mesh.cols(); ++b) {
+        const int point = mesh.node_point(a, b);
+        if (!sim.state().pinned(mesh, a, b) && predicate(sim.state().x(2, point) - goal_x(2, point))) return true;
+      }
+    return false;
+  };
+
+  // Up: double the pressure from twice levelling until every node is at or
+  // above its goal (the first step crosses levelling, from the mirror image
+  // of the sag, see sim/levelling_crossing.h).
+  double pressure = p_level;
+  do {
+    pressure = std::min(2.0 * pressure, p_max);
+    apply(Action::set_pressure(pressure));
+    progress(0.1, pressure, "raising");
+  } while (pressure < p_max && free_node_height_error([](double dz) { return dz < 0.0; }));
+
+  // Down: pin nodes and jam cells as they come down to their goals.
+  const double top = pressure;
+  double step = options_.decrement_pa;
+  while (pressure > p_floor) {
+    const double next = std::max(pressure - step, p_floor);
+    apply(Action::set_pressure(next));
+    if (step > options_.min_step_pa && free_node_height_error([&](double dz) { return dz < -tolerance_m; })) {
+      apply(Action::set_pressure(pressure));  // back off, halve the step
+      step /= 2.0;
+      continue;
+    }
+    pressure = next;
+    const std::size_t steps_before = result.steps.size();
+    bool all_done = true;
+    for (int a = 1; a < mesh.rows(); ++a)
+      for (int b = 1; b < mesh.cols(); ++b) {
+        if (sim.state().pinned(mesh, a, b)) continue;
+        const int point = mesh.node_point(a, b);
+        if (sim.state().x(2, point) <= goal_x(2, point)) apply(Action::pin(a, b));
+        else all_done = false;
+      }
+    for (int r = 0; r < mesh.rows(); ++r)
+      for (int c = 0; c < mesh.cols(); ++c) {
+        if (sim.state().jammed(mesh, r, c)) continue;
+        if (cell_curvature(mesh, sim.state().x, r, c) <= goal_curvature(r, c)) apply(Action::jam(r, c));
+        else all_done = false;
+      }
+    progress(0.1 + 0.8 * (top - pressure) / std::max(top - p_floor, 1e-9), pressure, "lowering");
+    if (all_done) break;
+    if (result.steps.size() > steps_before + 1) step = options_.decrement_pa;  // pinned or jammed: full steps again
+  }
+
+  // End pressure: with the pins and jams set, cells between pins sag below
+  // levelling and bulge above it. From the pressure reached, step through
+  // the end pressures downwards while the correlation improves, else
+  // upwards while it improves (a hill climb), and end at the best.
+  const auto score = [&] {
+    return correlate(request.goal_mm, point_heights(mesh, sim.state().x) * 1000.0).value.value_or(-INFINITY);
+  };
+  std::vector<double> below, above;
+  for (double f : kEndPressureFactors) {
+    const double p = f * p_level;
+    if (p < pressure) below.insert(below.begin(), p);
+    else if (p > pressure && p <= p_max) above.push_back(p);
+  }
+  double best_pressure = pressure, best_r = score();
+  for (const std::vector<double>* direction : {&below, &above}) {
+    const double from = best_pressure;
+    for (double p : *direction) {
+      apply(Action::set_pressure(p));
+      const double r = score();
+      if (!(r > best_r)) break;
+      best_r = r, best_pressure = p;
+    }
+    if (best_pressure != from) break;
+  }
+  if (sim.state().pressure_pa != best_pressure) apply(Action::set_pressure(best_pressure));
+  progress(1.0, best_pressure, "done");
+  result.final_state = sim.state();
+  return result;
+}
+
+namespace {
+const bool registered = (register_planner("from-above", [] { return std::make_unique<FromAbove>(); }), true);
+}  // namespace
+
+}  // namespace hj
