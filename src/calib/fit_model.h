@@ -12,6 +12,7 @@
 
 #include "calib/least_squares.h"
 #include "calib/levelling.h"
+#include "calib/profile_likelihood.h"
 #include "calib/stiffness_bisection.h"
 
 namespace hj {
@@ -20,6 +21,11 @@ struct FitOptions {
   bool initial_estimates = true;  // levelling and Algorithm 1 before the joint fit
   BisectionOptions bisection;
   LeastSquaresOptions least_squares;
+  // After the joint fit, replace the linearised interval of each loosely
+  // constrained parameter by its profile-likelihood interval
+  // (profile_likelihood.h); costs a few warm-started refits per end.
+  bool profile_loose = false;
+  ProfileOptions profile;
 };
 
 struct StiffnessEstimate {
@@ -39,6 +45,10 @@ struct FitReport {
 // Stage ("levelling", "algorithm 1: spring_k", "least squares"), progress.
 using FitProgress = std::function<void(const std::string& stage, int done, int total, const std::string& detail)>;
 
+// The mass's 95 % interval is the levelling crossing's (when one was found),
+// not the joint fit's: the joint fit counts 1e5 samples as independent
+// evidence for a mass that the model ties to one pressure.
+//
 // Fits the baseline plus `effects` (switched on with their defaults unless
 // `start` has values for them).
 FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,
