@@ -43,20 +43,6 @@ void refine_on_bare_captures(const Dataset& dataset, const std::vector<FitParame
   }
 }
 
-// The mass's interval from the levelling crossing (see fit_model.h).
-void use_levelling_interval(const LevellingEstimate& levelling, LeastSquaresResult& joint,
-                            const LeastSquaresOptions& options) {
-  for (auto& e : joint.estimates) {
-    if (!e.active || !e.parameter.surface || e.parameter.spec.name != "mass_kg") continue;
-    e.linearised_low = e.ci95_low;
-    e.linearised_high = e.ci95_high;
-    e.ci95_low = levelling.mass_low_kg;
-    e.ci95_high = levelling.mass_high_kg;
-    e.interval_method = "levelling zero crossing";
-    e.loose = std::max(e.value - e.ci95_low, e.ci95_high - e.value) > options.loose_relative_halfwidth * std::abs(e.value);
-  }
-}
-
 }  // namespace
 
 FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,
@@ -104,7 +90,6 @@ FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std:
                                // The number of refits is not known beforehand; about 8 per end.
                                if (progress) progress("profile likelihood: " + name, evaluations, std::max(evaluations, 16), detail);
                              });
-  if (out.levelling.found) use_levelling_interval(out.levelling, out.joint, options.least_squares);
   return out;
 }
 

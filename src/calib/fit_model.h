@@ -45,10 +45,6 @@ struct FitReport {
 // Stage ("levelling", "algorithm 1: spring_k", "least squares"), progress.
 using FitProgress = std::function<void(const std::string& stage, int done, int total, const std::string& detail)>;
 
-// The mass's 95 % interval is the levelling crossing's (when one was found),
-// not the joint fit's: the joint fit counts 1e5 samples as independent
-// evidence for a mass that the model ties to one pressure.
-//
 // Fits the baseline plus `effects` (switched on with their defaults unless
 // `start` has values for them).
 FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,

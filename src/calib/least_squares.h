@@ -38,10 +38,9 @@ struct ParameterEstimate {
   bool active = true;
   bool at_bound = false;
   bool loose = false;
-  // How ci95 was found: "linearised" (value +- 1.96 std_error, as above),
-  // "profile likelihood" (profile_likelihood.h) or "levelling zero
-  // crossing" (the mass, levelling.h). When not linearised, the linearised
-  // interval is kept here (else NaN).
+  // How ci95 was found: "linearised" (value +- 1.96 std_error, as above)
+  // or "profile likelihood" (profile_likelihood.h). When not linearised,
+  // the linearised interval is kept here (else NaN).
   std::string interval_method = "linearised";
   double linearised_low = std::numeric_limits<double>::quiet_NaN();
   double linearised_high = std::numeric_limits<double>::quiet_NaN();

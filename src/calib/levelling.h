@@ -19,9 +19,10 @@ struct LevellingEstimate {
   std::string session;       // where the crossing was seen
   double below_pa = 0.0;     // the two captures' pressures around it
   double above_pa = 0.0;
-  // The 95 % interval of the crossing and so of the mass, from the
-  // crossing's own evidence (fit_cube_root_crossing), not from the joint fit
-  // of all samples.
+  // The 95 % interval of the crossing and so of the levelling mass, from
+  // the crossing's own evidence: fit_cube_root_crossing on the two captures
+  // either side of it (where the cube-root law holds), widened to hold the
+  // estimate; points and scatter_mm are that local fit's.
   double pressure_low_pa = 0.0, pressure_high_pa = 0.0;
   double mass_low_kg = 0.0, mass_high_kg = 0.0;
   int points = 0;            // unjammed, unpinned captures in the cube-root fit

@@ -56,25 +56,25 @@ class EndSearch {
     }
     if (!bracketed) return {inside, true};
     // Bisect, each time at the interpolated crossing of the signed root
-    // (nearly linear in the value), kept off the bracket's ends.
-    auto crossing = [&] {
+    // (nearly linear in the value), kept off the bracket's ends, until the
+    // bracket is narrow or one of its ends is close in the statistic
+    // itself (signed root within 2 % of 1); the end is then interpolated.
+    auto fraction = [&] {
       if (!std::isfinite(outside_root)) return 0.5;
-      return std::clamp((1.0 - inside_root) / (outside_root - inside_root), 0.1, 0.9);
+      return std::clamp((1.0 - inside_root) / (outside_root - inside_root), 0.0, 1.0);
     };
-    while (std::abs(outside - inside) > search_.tolerance) {
-      const double t = inside + crossing() * (outside - inside);
+    auto close = [](double root) { return std::abs(root - 1.0) < 0.02; };
+    while (std::abs(outside - inside) > search_.tolerance && !close(inside_root) && !close(outside_root)) {
+      const double t = inside + std::clamp(fraction(), 0.1, 0.9) * (outside - inside);
       const double root = signed_root(t, side);
       if (root > 1.0)
         outside = t, outside_root = root;
       else
         inside = t, inside_root = root;
-      // Close enough in the statistic itself: the cost rise is within a
-      // few per cent of the threshold.
-      if (std::abs(root - 1.0) < 0.02) return {t, false};
     }
     // Next to a value the model cannot replay, the last one it could.
     if (!std::isfinite(outside_root)) return {inside, false};
-    return {inside + crossing() * (outside - inside), false};
+    return {inside + fraction() * (outside - inside), false};
   }
 
  private:

@@ -66,10 +66,10 @@ using ProfileCost = std::function<double(double value, int side)>;
 // the cost rises past the threshold or the bound is reached, then bisects
 // the bracket, each time at the point where the signed root
 // sqrt(rise / threshold) interpolates to 1, kept within the bracket's
-// middle 80 %, until it is narrower than the tolerance (the end is then
-// that interpolated point) or a point's signed root is within 2 % of 1
-// (the end is that point). Next to a value the model cannot replay, the
-// end is the last value it could.
+// middle 80 %, until it is narrower than the tolerance or an end's signed
+// root is within 2 % of 1; the end is the interpolated crossing of the
+// final bracket. Next to a value the model cannot replay, the end is the
+// last value it could.
 ProfileInterval profile_interval(const ProfileCost& cost, const ProfileSearch& search,
                                  const ProfileProgress& progress = {});
 
