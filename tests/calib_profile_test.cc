@@ -13,6 +13,7 @@
 
 #include "calib/levelling.h"
 #include "calib/profile_likelihood.h"
+#include "expect_error.h"
 
 namespace hj {
 namespace {
@@ -149,6 +150,19 @@ TEST(ProfileInterval, AValueTheModelCannotReplayCountsAsOutside) {
   EXPECT_LE(p.high, 4.0);
   EXPECT_GT(p.high, 4.0 - 0.02);
   EXPECT_EQ(calls, p.evaluations);
+}
+
+TEST(ProfileLooseParameters, NamesAParameterItCannotProfile) {
+  // A fit that estimated only spring_k: kappa_jam was held.
+  const std::vector<FitParameter> parameters = fit_parameters({});
+  LeastSquaresResult fit;
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    fit.estimates.push_back({parameters[k], 1.0});
+    if (parameters[k].spec.name == "spring_k") fit.active.push_back(static_cast<int>(k));
+  }
+  testing_support::expect_error<std::invalid_argument>(
+      [&] { profile_loose_parameters(Dataset{}, parameters, {}, {}, fit, {}, {"kappa_jam"}); },
+      {"kappa_jam", "not a parameter the fit estimated"});
 }
 
 // Centre heights of a net without pre-tension around its levelling

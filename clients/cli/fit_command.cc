@@ -19,7 +19,7 @@ namespace {
 
 constexpr const char* kFitUsage =
     "usage: hapticjam fit DATASET --out DIR [--effects a,b] [--holdout NAME,NAME] [--params START]\n"
-    "                     [--max-iterations N] [--no-initial] [--segments P] [--threads N]\n"
+    "                     [--max-iterations N] [--no-initial] [--profile A,B] [--segments P] [--threads N]\n"
     "Fits the model to the sessions of DATASET: the mass from the levelling pressure, the\n"
     "spring and jammed bending stiffnesses by the paper's Algorithm 1 (bisection), then every\n"
     "parameter (the baseline's and the effects') jointly by bounded least squares (Ceres).\n"
@@ -29,7 +29,8 @@ constexpr const char* kFitUsage =
     "  --holdout A,B       fit without these sessions and report the error on them\n"
     "  --params START      start from these values (default: the paper's)\n"
     "  --max-iterations N  least-squares iterations (default 20)\n"
-    "  --no-initial        skip the levelling and Algorithm 1 estimates\n";
+    "  --no-initial        skip the levelling and Algorithm 1 estimates\n"
+    "  --profile A,B       profile-likelihood intervals for these parameters too (loose ones always)\n";
 
 int fit(const CalibArgs& args) {
   const auto start = std::chrono::steady_clock::now();
@@ -45,6 +46,7 @@ int fit(const CalibArgs& args) {
   options.least_squares.replay = fitting_replay(replay_options(args));
   options.bisection.replay = options.least_squares.replay;
   options.profile_loose = true;
+  options.profile_also = args.profile;
   StageProgress progress;
   const FitReport report = fit_model(train, start_model, start_model.effects, options, std::ref(progress));
   const LeastSquaresResult& joint = report.joint;
@@ -152,7 +154,7 @@ int run_fit(const std::vector<std::string>& args) {
   return run_subcommand<CalibArgs>(
       "fit", kFitUsage, args,
       [](const std::vector<std::string>& a) {
-        return parse_calib_args(a, {"--params", "--effects", "--holdout", "--max-iterations", "--no-initial",
+        return parse_calib_args(a, {"--params", "--effects", "--holdout", "--max-iterations", "--no-initial", "--profile",
                                     "--segments", "--threads"});
       },
       fit);

@@ -89,7 +89,8 @@ FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std:
                              [&](const std::string& name, int evaluations, const std::string& detail) {
                                // The number of refits is not known beforehand; about 8 per end.
                                if (progress) progress("profile likelihood: " + name, evaluations, std::max(evaluations, 16), detail);
-                             });
+                             },
+                             options.profile_also);
   return out;
 }
 

@@ -25,6 +25,7 @@ struct FitOptions {
   // constrained parameter by its profile-likelihood interval
   // (profile_likelihood.h); costs a few warm-started refits per end.
   bool profile_loose = false;
+  std::vector<std::string> profile_also;  // qualified names profiled even when not loose
   ProfileOptions profile;
 };
 

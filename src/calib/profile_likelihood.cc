@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <stdexcept>
 
 #include "calib/parallel_for.h"
 
@@ -206,13 +207,19 @@ class ChordRefit {
 
 void profile_loose_parameters(const Dataset& dataset, const std::vector<FitParameter>& parameters,
                               const LeastSquaresOptions& fit_options, const ProfileOptions& options,
-                              LeastSquaresResult& fit, const ParameterProfileProgress& progress) {
+                              LeastSquaresResult& fit, const ParameterProfileProgress& progress,
+                              const std::vector<std::string>& also) {
   const std::vector<long> rows = capture_rows(dataset);
+  for (const auto& name : also) {
+    bool found = false;
+    for (int k : fit.active) found = found || parameters[k].qualified_name() == name;
+    if (!found) throw std::invalid_argument("cannot profile \"" + name + "\": not a parameter the fit estimated");
+  }
   const int active = static_cast<int>(fit.active.size());
   for (int a = 0; a < active; ++a) {
     ParameterEstimate& e = fit.estimates[fit.active[a]];
-    if (!e.loose) continue;
     const FitParameter& profiled = parameters[fit.active[a]];
+    if (!e.loose && std::find(also.begin(), also.end(), profiled.qualified_name()) == also.end()) continue;
     ProfileSearch search;
     search.value = e.value;
     search.min_cost = fit.sum_sq_mm2;

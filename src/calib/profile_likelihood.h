@@ -86,10 +86,14 @@ struct ProfileOptions {
 // half-width; the others refitted at each point by chord steps with the
 // fit's Jacobian, warm-started), sets interval_method to "profile likelihood" and
 // keeps the linearised one in linearised_low/high. `loose` is then judged
-// on the profile interval.
+// on the profile interval. Parameters whose qualified name is in `also` are
+// profiled even when not loose.
+// @throws std::invalid_argument naming a name of `also` that is no active
+//         parameter of the fit.
 using ParameterProfileProgress = std::function<void(const std::string& parameter, int evaluations, const std::string& detail)>;
 void profile_loose_parameters(const Dataset& dataset, const std::vector<FitParameter>& parameters,
                               const LeastSquaresOptions& fit_options, const ProfileOptions& options,
-                              LeastSquaresResult& fit, const ParameterProfileProgress& progress = {});
+                              LeastSquaresResult& fit, const ParameterProfileProgress& progress = {},
+                              const std::vector<std::string>& also = {});
 
 }  // namespace hj
