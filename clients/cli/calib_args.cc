@@ -34,6 +34,7 @@ CalibArgs parse_calib_args(const std::vector<std::string>& args, const std::set<
     else if (a == "--params") out.params_file = cursor.value();
     else if (a == "--effects") out.effects = split_list(a, cursor.value());
     else if (a == "--holdout") out.holdout = split_list(a, cursor.value());
+    else if (a == "--profile") out.profile = split_list(a, cursor.value());
     else if (a == "--segments") out.segments = parse_int(a, cursor.value(), 2, 64);
     else if (a == "--threads") out.threads = parse_int(a, cursor.value(), 0, 256);
     else if (a == "--max-iterations") out.max_iterations = parse_int(a, cursor.value(), 1, 1000);

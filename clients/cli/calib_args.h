@@ -20,6 +20,7 @@ struct CalibArgs {
   std::string params_file;            // --params
   std::vector<std::string> effects;   // --effects a,b
   std::vector<std::string> holdout;   // --holdout NAME,NAME
+  std::vector<std::string> profile;   // --profile NAME,NAME (qualified parameter names)
   int segments = 4;
   int threads = 0;                    // 0: one per core
   int max_iterations = 20;

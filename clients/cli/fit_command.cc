@@ -19,7 +19,7 @@ namespace {
 
 constexpr const char* kFitUsage =
     "usage: hapticjam fit DATASET --out DIR [--effects a,b] [--holdout NAME,NAME] [--params START]\n"
-    "                     [--max-iterations N] [--no-initial] [--segments P] [--threads N]\n"
+    "                     [--max-iterations N] [--no-initial] [--profile A,B] [--segments P] [--threads N]\n"
     "Fits the model to the sessions of DATASET: the mass from the levelling pressure, the\n"
     "spring and jammed bending stiffnesses by the paper's Algorithm 1 (bisection), then every\n"
     "parameter (the baseline's and the effects') jointly by bounded least squares (Ceres).\n"
@@ -29,7 +29,8 @@ constexpr const char* kFitUsage =
     "  --holdout A,B       fit without these sessions and report the error on them\n"
     "  --params START      start from these values (default: the paper's)\n"
     "  --max-iterations N  least-squares iterations (default 20)\n"
-    "  --no-initial        skip the levelling and Algorithm 1 estimates\n";
+    "  --no-initial        skip the levelling and Algorithm 1 estimates\n"
+    "  --profile A,B       profile-likelihood intervals for these parameters too (loose ones always)\n";
 
 int fit(const CalibArgs& args) {
   const auto start = std::chrono::steady_clock::now();
@@ -44,6 +45,8 @@ int fit(const CalibArgs& args) {
   options.least_squares.max_iterations = args.max_iterations;
   options.least_squares.replay = fitting_replay(replay_options(args));
   options.bisection.replay = options.least_squares.replay;
+  options.profile_loose = true;
+  options.profile_also = args.profile;
   StageProgress progress;
   const FitReport report = fit_model(train, start_model, start_model.effects, options, std::ref(progress));
   const LeastSquaresResult& joint = report.joint;
@@ -64,7 +67,11 @@ int fit(const CalibArgs& args) {
     levelling.update({{"pressure_pa", report.levelling.pressure_pa},
                       {"mass_kg", report.levelling.mass_kg},
                       {"session", report.levelling.session},
-                      {"between_pa", {report.levelling.below_pa, report.levelling.above_pa}}});
+                      {"between_pa", {report.levelling.below_pa, report.levelling.above_pa}},
+                      {"pressure_ci95_pa", {report.levelling.pressure_low_pa, report.levelling.pressure_high_pa}},
+                      {"mass_ci95_kg", {report.levelling.mass_low_kg, report.levelling.mass_high_kg}},
+                      {"points", report.levelling.points},
+                      {"scatter_mm", report.levelling.scatter_mm}});
   nlohmann::json algorithm1 = nlohmann::json::object();
   for (const auto& s : report.stiffnesses)
     algorithm1[s.parameter] = {{"value", s.result.value},
@@ -84,6 +91,7 @@ int fit(const CalibArgs& args) {
                                 {"algorithm1", algorithm1},
                                 {"least_squares", {{"iterations", joint.iterations},
                                                    {"jacobians", joint.jacobians},
+                                                   {"evaluations", joint.evaluations},
                                                    {"termination", joint.termination}}},
                                 {"dataset", all.dir.string()},
                                 {"seconds", seconds},
@@ -93,13 +101,14 @@ int fit(const CalibArgs& args) {
   write_model_params(out / "params.json", joint.params, extra);
 
   HtmlReport html("hapticjam fit: " + all.dir.filename().string());
-  char line[256];
+  char line[512];
   if (report.levelling.found) {
     std::snprintf(line, sizeof line,
                   "Levelling: the centre crosses the level at %.1f Pa (between %.0f and %.0f Pa in %s), so M = P A / g "
-                  "= %.4f kg.",
+                  "= %.4f kg (95 %%: %.4f .. %.4f kg, from the crossing's profile over %d captures, scatter %.2f mm).",
                   report.levelling.pressure_pa, report.levelling.below_pa, report.levelling.above_pa,
-                  report.levelling.session.c_str(), report.levelling.mass_kg);
+                  report.levelling.session.c_str(), report.levelling.mass_kg, report.levelling.mass_low_kg,
+                  report.levelling.mass_high_kg, report.levelling.points, report.levelling.scatter_mm);
     html.paragraph(line);
   } else {
     html.paragraph("Levelling: no unjammed session crosses the level; the mass starts from the given value.");
@@ -121,7 +130,8 @@ int fit(const CalibArgs& args) {
     };
     rows.push_back({e.parameter.qualified_name(), num(e.value), e.parameter.spec.unit,
                     e.active ? num(e.std_error) : "-",
-                    e.active ? num(e.ci95_low) + " .. " + num(e.ci95_high) : "not estimated (no effect)",
+                    e.active ? num(e.ci95_low) + " .. " + num(e.ci95_high) + " (" + e.interval_method + ")"
+                             : "not estimated (no effect)",
                     e.loose ? "loose" : ""});
   }
   html.table({"parameter", "value", "unit", "std. error", "95 % interval", ""}, rows);
@@ -144,7 +154,7 @@ int run_fit(const std::vector<std::string>& args) {
   return run_subcommand<CalibArgs>(
       "fit", kFitUsage, args,
       [](const std::vector<std::string>& a) {
-        return parse_calib_args(a, {"--params", "--effects", "--holdout", "--max-iterations", "--no-initial",
+        return parse_calib_args(a, {"--params", "--effects", "--holdout", "--max-iterations", "--no-initial", "--profile",
                                     "--segments", "--threads"});
       },
       fit);

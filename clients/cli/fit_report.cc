@@ -14,6 +14,11 @@ nlohmann::json uncertainties_json(const LeastSquaresResult& fit) {
       entry["ci95"] = {e.ci95_low, e.ci95_high};
       entry["at_bound"] = e.at_bound;
       entry["loose"] = e.loose;
+      entry["interval_method"] = e.interval_method;
+      if (e.interval_method != "linearised") {
+        entry["ci95_linearised"] = {e.linearised_low, e.linearised_high};
+        if (e.low_open || e.high_open) entry["ci95_open"] = {e.low_open, e.high_open};
+      }
     }
     out[e.parameter.qualified_name()] = entry;
   }
@@ -29,10 +34,17 @@ std::vector<std::string> parameter_lines(const LeastSquaresResult& fit) {
     if (!e.active) {
       std::snprintf(line, sizeof line, "%-24s %.6g %s (changes no capture; kept, not estimated)", name.c_str(), e.value,
                     unit);
-    } else {
+    } else if (e.interval_method == "linearised") {
       std::snprintf(line, sizeof line, "%-24s %.6g %s +- %.3g (95 %%: %.6g .. %.6g)%s%s", name.c_str(), e.value, unit,
                     1.96 * e.std_error, e.ci95_low, e.ci95_high, e.loose ? "  LOOSELY CONSTRAINED" : "",
                     e.at_bound ? "  at a bound" : "");
+    } else {
+      // An interval that need not be symmetric: its ends, how it was found,
+      // and the linearised one it replaces.
+      std::snprintf(line, sizeof line, "%-24s %.6g %s (95 %%: %s%.6g .. %.6g%s by %s; linearised %.6g .. %.6g)%s%s",
+                    name.c_str(), e.value, unit, e.low_open ? "<= " : "", e.ci95_low, e.ci95_high,
+                    e.high_open ? " (bound)" : "", e.interval_method.c_str(), e.linearised_low, e.linearised_high,
+                    e.loose ? "  LOOSELY CONSTRAINED" : "", e.at_bound ? "  at a bound" : "");
     }
     out.push_back(line);
   }
@@ -45,10 +57,10 @@ std::vector<std::string> loose_notes(const LeastSquaresResult& fit) {
   for (const auto& e : fit.estimates) {
     if (!e.active || !e.loose) continue;
     std::snprintf(line, sizeof line,
-                  "%s is only loosely constrained by these sessions: its 95 %% interval %.4g .. %.4g %s is %.0f %% of "
-                  "its value wide; sessions that load it more would pin it down.",
+                  "%s is only loosely constrained by these sessions: its 95 %% interval %.4g .. %.4g %s (%s) is %.0f "
+                  "%% of its value wide; sessions that load it more would pin it down.",
                   e.parameter.qualified_name().c_str(), e.ci95_low, e.ci95_high, e.parameter.spec.unit.c_str(),
-                  100.0 * (e.ci95_high - e.ci95_low) / std::max(std::abs(e.value), 1e-300));
+                  e.interval_method.c_str(), 100.0 * (e.ci95_high - e.ci95_low) / std::max(std::abs(e.value), 1e-300));
     out.push_back(line);
   }
   return out;

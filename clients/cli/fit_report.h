@@ -11,7 +11,10 @@
 
 namespace hj::cli {
 
-// {"spring_k": {"value", "std_error", "ci95": [lo, hi], "unit", "active", "at_bound", "loose"}, ...}
+// {"spring_k": {"value", "std_error", "ci95": [lo, hi], "unit", "active", "at_bound", "loose",
+//  "interval_method"}, ...}; where interval_method is not "linearised", also
+// "ci95_linearised": [lo, hi] (value +- 1.96 std_error) and, if an end of
+// the profile reached the parameter's bound, "ci95_open": [low, high].
 nlohmann::json uncertainties_json(const LeastSquaresResult& fit);
 
 // One line per parameter: value +- 95 % half-width, and a note when it is

@@ -1,5 +1,7 @@
 #include "calib/fit_model.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 
@@ -82,6 +84,13 @@ FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std:
                                   std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
                                   if (progress) progress("least squares", iteration, max_iterations, detail);
                                 });
+  if (options.profile_loose)
+    profile_loose_parameters(dataset, parameters, options.least_squares, options.profile, out.joint,
+                             [&](const std::string& name, int evaluations, const std::string& detail) {
+                               // The number of refits is not known beforehand; about 8 per end.
+                               if (progress) progress("profile likelihood: " + name, evaluations, std::max(evaluations, 16), detail);
+                             },
+                             options.profile_also);
   return out;
 }
 

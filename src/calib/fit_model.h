@@ -12,6 +12,7 @@
 
 #include "calib/least_squares.h"
 #include "calib/levelling.h"
+#include "calib/profile_likelihood.h"
 #include "calib/stiffness_bisection.h"
 
 namespace hj {
@@ -20,6 +21,12 @@ struct FitOptions {
   bool initial_estimates = true;  // levelling and Algorithm 1 before the joint fit
   BisectionOptions bisection;
   LeastSquaresOptions least_squares;
+  // After the joint fit, replace the linearised interval of each loosely
+  // constrained parameter by its profile-likelihood interval
+  // (profile_likelihood.h); costs a few warm-started refits per end.
+  bool profile_loose = false;
+  std::vector<std::string> profile_also;  // qualified names profiled even when not loose
+  ProfileOptions profile;
 };
 
 struct StiffnessEstimate {

@@ -51,6 +51,7 @@ class ScaledModel {
     }
     const int p = parameter_count(), sessions = static_cast<int>(dataset_.sessions.size());
     std::vector<ReplayTrace> traces(sessions);
+    ++evaluations_;
     r.resize(residual_count_all());
     if (!run(sessions, [&](int s) {
           r.segment(rows_[s], rows_[s + 1] - rows_[s]) = session_residuals(
@@ -102,6 +103,7 @@ class ScaledModel {
   }
 
   int jacobians() const { return jacobians_; }
+  int evaluations() const { return evaluations_; }
 
   // Takes r and J at u from elsewhere (the probe over all parameters).
   const std::vector<ReplayTrace>& traces() const { return cache_traces_; }
@@ -146,6 +148,7 @@ class ScaledModel {
   Eigen::MatrixXd cache_j_;
   std::vector<ReplayTrace> cache_traces_;  // per session, at cache_u_
   int jacobians_ = 0;
+  int evaluations_ = 0;
 };
 
 class DatasetCost : public ceres::CostFunction {
@@ -207,9 +210,8 @@ double total_sum_of_squares(const Dataset& dataset) {
   return n ? sum_sq - sum * sum / n : 0.0;
 }
 
-// The first residual row of each capture, in the order the residuals are
-// laid out (session by session, capture by capture, the measured samples),
-// and the total at the end.
+}  // namespace
+
 std::vector<long> capture_rows(const Dataset& dataset) {
   std::vector<long> rows = {0};
   for (const auto& session : dataset.sessions)
@@ -217,8 +219,6 @@ std::vector<long> capture_rows(const Dataset& dataset) {
       rows.push_back(rows.back() + static_cast<long>((capture.heights_mm.array() == capture.heights_mm.array()).count()));
   return rows;
 }
-
-}  // namespace
 
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
                                   std::vector<int>* rows) {
@@ -308,6 +308,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   if (!model.evaluate(u, out.residuals, &out.jacobian))
     throw std::runtime_error("the model fails to replay the dataset at the fitted values");
   out.jacobians = probe.jacobians() + model.jacobians();
+  out.evaluations = probe.evaluations() + model.evaluations();
   out.scale = scale_a;
   out.session_rows = model.rows();
   out.params = model.params_at(u);

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,13 @@ struct ParameterEstimate {
   bool active = true;
   bool at_bound = false;
   bool loose = false;
+  // How ci95 was found: "linearised" (value +- 1.96 std_error, as above)
+  // or "profile likelihood" (profile_likelihood.h). When not linearised,
+  // the linearised interval is kept here (else NaN).
+  std::string interval_method = "linearised";
+  double linearised_low = std::numeric_limits<double>::quiet_NaN();
+  double linearised_high = std::numeric_limits<double>::quiet_NaN();
+  bool low_open = false, high_open = false;  // a profile end that reached the parameter's bound
 };
 
 struct LeastSquaresResult {
@@ -49,6 +57,9 @@ struct LeastSquaresResult {
   double r2 = 0.0;  // 1 - SSR / SST over all compared samples, as the paper reports it
   int iterations = 0;
   int jacobians = 0;
+  // Replays of the whole dataset at a point (each Jacobian adds one per
+  // active parameter more, its difference columns).
+  int evaluations = 0;
   std::string termination;
   // At the optimum, for cross-validation without refitting from scratch:
   // the residuals (n), the Jacobian (n x p) in the scaled variables
@@ -74,6 +85,11 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
 // row of each (rows.size() == sessions + 1). Sessions run in parallel.
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
                                   std::vector<int>* rows = nullptr);
+
+// The first residual row of each capture, in the order the residuals are
+// laid out (session by session, capture by capture, the measured samples),
+// and the total at the end: the clusters of parameter_covariance().
+std::vector<long> capture_rows(const Dataset& dataset);
 
 // The covariance (p x p) of the parameters behind `jacobian` (n x p) at
 // residuals r (n), whose rows form clusters [cluster_rows[c],

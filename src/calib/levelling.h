@@ -5,6 +5,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "calib/dataset.h"
 
@@ -17,7 +19,32 @@ struct LevellingEstimate {
   std::string session;       // where the crossing was seen
   double below_pa = 0.0;     // the two captures' pressures around it
   double above_pa = 0.0;
+  // The 95 % interval of the crossing and so of the levelling mass, from
+  // the crossing's own evidence: fit_cube_root_crossing on the two captures
+  // either side of it (where the cube-root law holds), widened to hold the
+  // estimate; points and scatter_mm are that local fit's.
+  double pressure_low_pa = 0.0, pressure_high_pa = 0.0;
+  double mass_low_kg = 0.0, mass_high_kg = 0.0;
+  int points = 0;            // unjammed, unpinned captures in the cube-root fit
+  double scatter_mm = 0.0;   // their rms scatter about it
 };
+
+struct CubeRootCrossing {
+  double pressure_pa = 0.0;  // P0
+  double low_pa = 0.0;       // its 95 % interval
+  double high_pa = 0.0;
+  double scatter_mm = 0.0;   // rms of h - a cbrt(P - P0), on n - 2 degrees of freedom
+};
+
+// Fits h = a cbrt(P - P0) to (pressure Pa, centre height mm) points, P0 in
+// [lo, hi] (the two captures around the sign change). The 95 % interval of
+// P0 is its profile: the P0 (with a refitted) whose squared misfit exceeds
+// the minimum by at most t^2 s^2, s^2 = minimum / (n - 2), t the 97.5 %
+// point of Student's t on n - 2 degrees of freedom. So it is set by the
+// scatter of the heights about the law and by how steeply the height
+// changes with pressure where the captures are (the pressure steps), and it
+// may reach beyond [lo, hi]. With two points or fewer it is [lo, hi].
+CubeRootCrossing fit_cube_root_crossing(const std::vector<std::pair<double, double>>& points, double lo, double hi);
 
 // The measured height at the array's centre: the mean of the samples seen
 // within a quarter cell of it (NaN if none).

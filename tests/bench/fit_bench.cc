@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "calib/levelling.h"
 #include "calib/residuals.h"
 
 namespace {
@@ -46,5 +47,13 @@ void BM_SessionResiduals(benchmark::State& state, const std::string& name) {
 }
 BENCHMARK_CAPTURE(BM_SessionResiduals, unjammed_sweep, std::string("unjammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SessionResiduals, jammed_sweep, std::string("jammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// The levelling crossing with its 95 % interval (the mass interval of a
+// fit), on the demo's unjammed sweep.
+void BM_LevellingMass(benchmark::State& state) {
+  static const hj::Dataset d = hj::read_dataset(kBaseline);
+  for (auto _ : state) benchmark::DoNotOptimize(hj::levelling_mass(d, 9.81));
+}
+BENCHMARK(BM_LevellingMass)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
