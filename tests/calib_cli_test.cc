@@ -100,6 +100,11 @@ TEST(CalibCli, FitWritesLoadableParamsWithUncertaintiesAndHeldOutError) {
   EXPECT_TRUE(doc["uncertainties"]["spring_k"].contains("ci95"));
   EXPECT_TRUE(doc["heldout"].contains("rmse_mm"));
   EXPECT_LT(doc["heldout"]["rmse_mm"].get<double>(), 1.2);
+  // The notes name the parameter the data pin down least, whether or not
+  // it is flagged loose.
+  bool least = false;
+  for (const auto& note : doc["notes"]) least = least || note.get<std::string>().find("is the least constrained parameter") != std::string::npos;
+  EXPECT_TRUE(least) << doc["notes"].dump();
   const ModelParams loaded = read_model_params(out / "params.json", SurfaceParameters{});
   EXPECT_NEAR(loaded.surface.spring_k, 58.0, 0.03 * 58.0);
   expect_self_contained(out / "report.html");

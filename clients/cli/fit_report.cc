@@ -1,5 +1,6 @@
 #include "fit_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -61,6 +62,24 @@ std::vector<std::string> loose_notes(const LeastSquaresResult& fit) {
                   "%% of its value wide; sessions that load it more would pin it down.",
                   e.parameter.qualified_name().c_str(), e.ci95_low, e.ci95_high, e.parameter.spec.unit.c_str(),
                   e.interval_method.c_str(), 100.0 * (e.ci95_high - e.ci95_low) / std::max(std::abs(e.value), 1e-300));
+    out.push_back(line);
+  }
+  // Which parameter the data pin down least, beside the others, whether or
+  // not it passes the loose threshold (a reader compares, a flag does not).
+  std::vector<std::pair<double, std::string>> widths;
+  for (const auto& e : fit.estimates)
+    if (e.active && e.value != 0.0)
+      widths.emplace_back(std::max(e.value - e.ci95_low, e.ci95_high - e.value) / std::abs(e.value),
+                          e.parameter.qualified_name());
+  if (widths.size() >= 2) {
+    std::sort(widths.rbegin(), widths.rend());
+    std::string others;
+    for (std::size_t k = 1; k < widths.size(); ++k) {
+      std::snprintf(line, sizeof line, "%s%s %.2g %%", k > 1 ? ", " : "", widths[k].second.c_str(), 100.0 * widths[k].first);
+      others += line;
+    }
+    std::snprintf(line, sizeof line, "%s is the least constrained parameter: 95 %% half-width %.2g %% of its value (%s).",
+                  widths[0].second.c_str(), 100.0 * widths[0].first, others.c_str());
     out.push_back(line);
   }
   return out;

@@ -21,7 +21,8 @@ nlohmann::json uncertainties_json(const LeastSquaresResult& fit);
 // loose, at a bound or has no effect on the captures.
 std::vector<std::string> parameter_lines(const LeastSquaresResult& fit);
 
-// Sentences about the parameters that the data constrain only loosely.
+// Sentences about the parameters that the data constrain only loosely, and
+// which one they constrain least (with the relative widths of the others).
 std::vector<std::string> loose_notes(const LeastSquaresResult& fit);
 
 }  // namespace hj::cli
