@@ -40,6 +40,7 @@ bool ShiftedSolver::solve(const Eigen::SparseMatrix<double>& a, double mu, const
     dx = bicg.solve(r);
     if (bicg.info() == Eigen::Success && dx.allFinite()) {
       ++iterative_solves_;
+      last_direct_ = false;
       return true;
     }
     failed_mu_ = mu;
@@ -52,6 +53,14 @@ bool ShiftedSolver::solve(const Eigen::SparseMatrix<double>& a, double mu, const
   if (direct_->lu.info() != Eigen::Success) return false;
   dx = direct_->lu.solve(r);
   ++direct_solves_;
+  last_direct_ = true;
+  return dx.allFinite();
+}
+
+bool ShiftedSolver::solve_again(const Eigen::SparseMatrix<double>& a, double mu, const Eigen::VectorXd& r,
+                                Eigen::VectorXd& dx) {
+  if (!last_direct_) return solve(a, mu, r, dx);  // iterations are cheap
+  dx = direct_->lu.solve(r);
   return dx.allFinite();
 }
 

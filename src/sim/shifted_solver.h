@@ -23,6 +23,10 @@ class ShiftedSolver {
   // false if no solve succeeded (a singular a); dx is then unspecified.
   bool solve(const Eigen::SparseMatrix<double>& a, double mu, const Eigen::VectorXd& r, Eigen::VectorXd& dx);
 
+  // Solves with the matrix of the last successful solve() again (a second
+  // right-hand side): the LU is reused, not refactorised.
+  bool solve_again(const Eigen::SparseMatrix<double>& a, double mu, const Eigen::VectorXd& r, Eigen::VectorXd& dx);
+
   int iterative_solves() const { return iterative_solves_; }
   int direct_solves() const { return direct_solves_; }
 
@@ -32,6 +36,7 @@ class ShiftedSolver {
   // The smallest mu at which the iterative solve last failed: below it (and
   // a little above) go straight to the LU.
   double failed_mu_ = 0.0;
+  bool last_direct_ = false;
   int iterative_solves_ = 0;
   int direct_solves_ = 0;
 };

@@ -5,10 +5,13 @@
 // so it starts as a heavily damped relaxation from the previous state and
 // ends as Newton. mu follows one of two controls (static_solver.cc): a fast
 // one that keeps each move near the cap, tried first, and a careful one that
-// shrinks mu only while the linear model predicts the residual. A converged
-// state whose symmetric stiffness is not positive definite (a saddle, or the
-// creased net near levelling) is pushed along its unstable mode and settled
-// again.
+// shrinks mu only while the linear model predicts the residual; where that
+// does not settle either, the careful one again with curved steps (geodesic
+// acceleration, for jammed cells turning on a soft net). A converged
+// state along which K diverges (divergence_mode.h: a saddle, or the creased
+// net near levelling) is pushed along that mode and settled again; a push
+// that reaches no other equilibrium within push_iterations goes back, and
+// the settle ends there, reported marginal.
 #pragma once
 
 #include <functional>
