@@ -19,17 +19,9 @@ Algorithm2::Algorithm2(Algorithm2Options options) : options_(options) {
 
 PlanResult Algorithm2::plan(const PlanRequest& request, const PlanCallbacks& callbacks) const {
   validate_plan_request(request, Mesh(request.geometry));
-  auto start = [&] {
-    try {
-      return Simulator(request.geometry, request.params, simulator_options(request, callbacks));
-    } catch (const SettleInterrupted&) {
-      throw PlanCancelled();
-    }
-  };
-  Simulator sim = start();
+  Simulator sim = start_simulator(request, callbacks);
   const Mesh& mesh = sim.mesh();
-  const double p_max = options_.max_pressure_pa > 0.0 ? std::min(options_.max_pressure_pa, request.params.max_pressure_pa)
-                                                      : request.params.max_pressure_pa;
+  const double p_max = plan_max_pressure(options_.max_pressure_pa, request.params);
 
   // The goal as a surface on the mesh, for its node heights and curvatures.
   Eigen::Matrix3Xd goal_x = mesh.rest_positions();
@@ -38,16 +30,7 @@ PlanResult Algorithm2::plan(const PlanRequest& request, const PlanCallbacks& cal
   const Eigen::MatrixXd goal_curvature = cell_curvatures(mesh, goal_x);
 
   PlanResult result;
-  auto apply = [&](const Action& action) {
-    if (callbacks.cancelled && callbacks.cancelled()) throw PlanCancelled();
-    try {
-      sim.apply(action);
-    } catch (const SettleInterrupted&) {
-      throw PlanCancelled();
-    }
-    result.steps.push_back(action);
-    if (callbacks.snapshot) callbacks.snapshot(sim.state());
-  };
+  auto apply = [&](const Action& action) { apply_planned(sim, action, result, callbacks); };
   const int increments = static_cast<int>(std::ceil(p_max / options_.pressure_increment_pa - 1e-9));
   for (int n = 1; n <= increments; ++n) {
     const double pressure = std::min(n * options_.pressure_increment_pa, p_max);

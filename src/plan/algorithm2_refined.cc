@@ -127,8 +127,7 @@ Algorithm2Refined::Algorithm2Refined(Algorithm2RefinedOptions options) : options
 PlanResult Algorithm2Refined::plan(const PlanRequest& request, const PlanCallbacks& callbacks) const {
   const Mesh mesh(request.geometry);
   validate_plan_request(request, mesh);
-  const double p_max = options_.max_pressure_pa > 0.0 ? std::min(options_.max_pressure_pa, request.params.max_pressure_pa)
-                                                      : request.params.max_pressure_pa;
+  const double p_max = plan_max_pressure(options_.max_pressure_pa, request.params);
   std::vector<Variant> variants;
   for (double s : options_.height_scales)
     for (double d : options_.increments_pa)

@@ -35,17 +35,9 @@ FromAbove::FromAbove(FromAboveOptions options) : options_(options) { options_.va
 
 PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& callbacks) const {
   validate_plan_request(request, Mesh(request.geometry));
-  auto start = [&] {
-    try {
-      return Simulator(request.geometry, request.params, simulator_options(request, callbacks));
-    } catch (const SettleInterrupted&) {
-      throw PlanCancelled();
-    }
-  };
-  Simulator sim = start();
+  Simulator sim = start_simulator(request, callbacks);
   const Mesh& mesh = sim.mesh();
-  const double p_max = options_.max_pressure_pa > 0.0 ? std::min(options_.max_pressure_pa, request.params.max_pressure_pa)
-                                                      : request.params.max_pressure_pa;
+  const double p_max = plan_max_pressure(options_.max_pressure_pa, request.params);
   const double p_level = request.params.levelling_pressure_pa(mesh);
   // Below levelling the cells between pinned nodes sag, which brings the
   // nodes around a pinned summit down to goals under the straight line from
@@ -63,16 +55,7 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
       1000.0;
 
   PlanResult result;
-  auto apply = [&](const Action& action) {
-    if (callbacks.cancelled && callbacks.cancelled()) throw PlanCancelled();
-    try {
-      sim.apply(action);
-    } catch (const SettleInterrupted&) {
-      throw PlanCancelled();
-    }
-    result.steps.push_back(action);
-    if (callbacks.snapshot) callbacks.snapshot(sim.state());
-  };
+  auto apply = [&](const Action& action) { apply_planned(sim, action, result, callbacks); };
   auto progress = [&](double fraction, double pressure_pa, const char* phase) {
     if (!callbacks.progress) return;
     char what[64];

@@ -54,4 +54,27 @@ SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbac
   return options;
 }
 
+Simulator start_simulator(const PlanRequest& request, const PlanCallbacks& callbacks) {
+  try {
+    return Simulator(request.geometry, request.params, simulator_options(request, callbacks));
+  } catch (const SettleInterrupted&) {
+    throw PlanCancelled();
+  }
+}
+
+void apply_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks) {
+  if (callbacks.cancelled && callbacks.cancelled()) throw PlanCancelled();
+  try {
+    sim.apply(action);
+  } catch (const SettleInterrupted&) {
+    throw PlanCancelled();
+  }
+  result.steps.push_back(action);
+  if (callbacks.snapshot) callbacks.snapshot(sim.state());
+}
+
+double plan_max_pressure(double option_pa, const SurfaceParameters& params) {
+  return option_pa > 0.0 ? std::min(option_pa, params.max_pressure_pa) : params.max_pressure_pa;
+}
+
 }  // namespace hj

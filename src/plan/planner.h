@@ -63,6 +63,18 @@ void register_planner(const std::string& name, std::function<std::unique_ptr<Pla
 // between actions (catch SettleInterrupted, throw PlanCancelled).
 SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbacks& callbacks);
 
+// The request's simulator settled at rest, its settles cancellable
+// (SettleInterrupted becomes PlanCancelled).
+Simulator start_simulator(const PlanRequest& request, const PlanCallbacks& callbacks);
+
+// Applies one planned action: cancellation checked first, a cancelled
+// settle thrown as PlanCancelled, the action recorded in result.steps and
+// the state sent to callbacks.snapshot.
+void apply_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks);
+
+// A planner's pressure ceiling: its option (0: none) capped by the device's.
+double plan_max_pressure(double option_pa, const SurfaceParameters& params);
+
 // Checks a request's goal against its mesh (shape, finite values).
 void validate_plan_request(const PlanRequest& request, const Mesh& mesh);
 
