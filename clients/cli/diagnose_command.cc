@@ -39,6 +39,10 @@ nlohmann::json candidate_json(const CandidateFit& c) {
           {"params", model_params_json(c.fit.params)},
           {"uncertainties", uncertainties_json(c.fit)}};
   if (c.screened_out) j["screening"] = c.screening_note;
+  if (c.screened)
+    j["predicted"] = {{"rmse_mm", c.predicted_rmse_mm},
+                      {"heldout_rmse_mm", c.predicted_heldout_rmse_mm},
+                      {"delta_bic", c.predicted_delta_bic}};
   return j;
 }
 

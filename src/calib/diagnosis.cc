@@ -89,6 +89,10 @@ bool screen_out(const Dataset& dataset, const LeastSquaresResult& current, doubl
     const double ratio = p.reference_heldout_rmse_mm > 0.0 ? p.heldout_rmse_mm / p.reference_heldout_rmse_mm : 1.0;
     const double gain = 1.0 - ratio;
     const double delta_bic = bic(predicted) - bic(current);
+    c.screened = true;
+    c.predicted_rmse_mm = p.rmse_mm;
+    c.predicted_heldout_rmse_mm = current_heldout * ratio;
+    c.predicted_delta_bic = delta_bic;
     if (gain >= options.screen_margin * options.min_heldout_gain && delta_bic < options.screen_margin * options.max_delta_bic)
       return false;
     char note[200];

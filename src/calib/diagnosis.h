@@ -43,6 +43,8 @@ struct CandidateFit {
   // are the screening's predictions, and screening_note says why.
   bool screened_out = false;
   std::string screening_note;
+  bool screened = false;  // the screening's predictions below exist
+  double predicted_rmse_mm = 0.0, predicted_heldout_rmse_mm = 0.0, predicted_delta_bic = 0.0;
 };
 
 struct LadderStep {
