@@ -39,6 +39,7 @@ CalibArgs parse_calib_args(const std::vector<std::string>& args, const std::set<
     else if (a == "--threads") out.threads = parse_int(a, cursor.value(), 0, 256);
     else if (a == "--max-iterations") out.max_iterations = parse_int(a, cursor.value(), 1, 1000);
     else if (a == "--no-initial") out.initial_estimates = false;
+    else if (a == "--no-screening") out.screening = false;
     else if (a == "--scale-mm") {
       out.scale_mm = parse_number(a, cursor.value());
       if (out.scale_mm <= 0.0) throw std::invalid_argument("--scale-mm must be positive");

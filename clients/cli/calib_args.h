@@ -25,6 +25,7 @@ struct CalibArgs {
   int threads = 0;                    // 0: one per core
   int max_iterations = 20;
   bool initial_estimates = true;      // --no-initial turns off levelling + Algorithm 1
+  bool screening = true;              // --no-screening: diagnose refits every candidate
   double scale_mm = 5.0;              // heat map colour scale
 };
 

@@ -18,23 +18,32 @@ namespace {
 
 constexpr const char* kDiagnoseUsage =
     "usage: hapticjam diagnose DATASET --out DIR [--effects a,b] [--params START] [--max-iterations N]\n"
-    "                          [--segments P] [--threads N]\n"
+    "                          [--segments P] [--threads N] [--no-screening]\n"
     "Which physical effect is the model missing? Fits the baseline, then refits with each\n"
     "candidate effect of the registry added, judging each by its leave-one-session-out error\n"
     "and BIC; adds effects greedily while one still helps. Writes DIR/diagnosis.json and\n"
     "DIR/report.html (with the error ladder).\n"
     "  --effects a,b   candidates to try (default: every optional effect in the registry)\n"
-    "  --params START  baseline values to start from (default: the paper's)\n";
+    "  --params START  baseline values to start from (default: the paper's)\n"
+    "  --no-screening  refit every candidate (default: only those whose predicted gain, from one\n"
+    "                  Gauss-Newton step at the current optimum, could pass; see README)\n";
 
 nlohmann::json candidate_json(const CandidateFit& c) {
-  return {{"effect", c.added},
+  nlohmann::json j = {{"effect", c.added},
           {"effects", c.effects},
           {"rmse_mm", c.fit.rmse_mm},
           {"heldout_rmse_mm", c.heldout_rmse_mm},
           {"delta_bic", c.delta_bic},
           {"significant", c.significant},
+          {"screened_out", c.screened_out},
           {"params", model_params_json(c.fit.params)},
           {"uncertainties", uncertainties_json(c.fit)}};
+  if (c.screened_out) j["screening"] = c.screening_note;
+  if (c.screened)
+    j["predicted"] = {{"rmse_mm", c.predicted_rmse_mm},
+                      {"heldout_rmse_mm", c.predicted_heldout_rmse_mm},
+                      {"delta_bic", c.predicted_delta_bic}};
+  return j;
 }
 
 std::string num(double v, const char* format = "%.3f") {
@@ -52,6 +61,7 @@ int diagnose_dataset(const CalibArgs& args) {
   const ModelParams start_model = start_params(base_args, dataset);
   DiagnoseOptions options;
   options.candidates = args.effects;
+  options.screening = args.screening;
   options.fit.least_squares.max_iterations = args.max_iterations;
   options.fit.least_squares.replay = fitting_replay(replay_options(args));
   options.fit.bisection.replay = options.fit.least_squares.replay;
@@ -128,7 +138,7 @@ int diagnose_dataset(const CalibArgs& args) {
   rows.push_back({"baseline", num(base.rmse_mm), num(d.baseline_heldout_rmse_mm), "0", ""});
   for (const auto& c : d.ranking)
     rows.push_back({c.added, num(c.fit.rmse_mm), num(c.heldout_rmse_mm), num(c.delta_bic, "%.1f"),
-                    c.significant ? "significant" : ""});
+                    c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : ""});
   html.table({"effect", "RMSE mm", "held-out RMSE mm", "delta BIC", ""}, rows);
   if (!d.later_rounds.empty()) {
     html.heading("Later rounds (on top of the chosen effects)");
@@ -137,7 +147,7 @@ int diagnose_dataset(const CalibArgs& args) {
       std::string on;
       for (const auto& e : c.effects) on += (on.empty() ? "" : " + ") + e;
       rows.push_back({on, num(c.fit.rmse_mm), num(c.heldout_rmse_mm), num(c.delta_bic, "%.1f"),
-                      c.significant ? "significant" : ""});
+                      c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : ""});
     }
     html.table({"effects", "RMSE mm", "held-out RMSE mm", "delta BIC", ""}, rows);
   }
@@ -154,7 +164,8 @@ int diagnose_dataset(const CalibArgs& args) {
               dataset.dir.filename().c_str(), base.rmse_mm, d.baseline_heldout_rmse_mm, d.noise_floor_mm);
   for (const auto& c : d.ranking)
     std::printf("  %-20s RMSE %.3f  held out %.3f  dBIC %10.1f %s\n", c.added.c_str(), c.fit.rmse_mm,
-                c.heldout_rmse_mm, c.delta_bic, c.significant ? "significant" : "");
+                c.heldout_rmse_mm, c.delta_bic,
+                c.significant ? "significant" : c.screened_out ? ("screened out: " + c.screening_note).c_str() : "");
   for (const auto& f : d.pattern.findings) std::printf("%s\n", f.c_str());
   for (const auto& t : progress.timing())
     std::printf("  time in %-40s %7.1f s wall %7.1f s CPU\n", t["stage"].get<std::string>().c_str(),
@@ -170,7 +181,7 @@ int run_diagnose(const std::vector<std::string>& args) {
   return run_subcommand<CalibArgs>(
       "diagnose", kDiagnoseUsage, args,
       [](const std::vector<std::string>& a) {
-        return parse_calib_args(a, {"--params", "--effects", "--max-iterations", "--segments", "--threads"});
+        return parse_calib_args(a, {"--params", "--effects", "--max-iterations", "--segments", "--threads", "--no-screening"});
       },
       diagnose_dataset);
 }

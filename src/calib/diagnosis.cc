@@ -35,10 +35,8 @@ bool is_significant(const CandidateFit& c, double reference_heldout_mm, const Di
 // neutral; where the model cannot replay the defaults (area_pressure's
 // default is the full effect, which moves the levelling pressure), the
 // effect's parameters start at their lower, then their upper bounds.
-LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& current,
-                                 const std::vector<std::string>& effects, const std::vector<FitParameter>& parameters,
-                                 const std::string& added, const DiagnoseOptions& options,
-                                 const LeastSquaresProgress& progress) {
+std::vector<ModelParams> candidate_starts(const ModelParams& current, const std::vector<std::string>& effects,
+                                          const std::vector<FitParameter>& parameters, const std::string& added) {
   const ModelParams start = with_effects(current, effects);
   std::vector<ModelParams> starts = {start, start, start};
   for (const auto& p : parameters)
@@ -46,6 +44,14 @@ LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& curr
       set_parameter_value(starts[1], p, p.spec.lower);
       set_parameter_value(starts[2], p, p.spec.upper);
     }
+  return starts;
+}
+
+LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& current,
+                                 const std::vector<std::string>& effects, const std::vector<FitParameter>& parameters,
+                                 const std::string& added, const DiagnoseOptions& options,
+                                 const LeastSquaresProgress& progress) {
+  const std::vector<ModelParams> starts = candidate_starts(current, effects, parameters, added);
   for (size_t k = 0;; ++k) {
     try {
       return fit_least_squares(dataset, starts[k], parameters, options.fit.least_squares, progress);
@@ -53,6 +59,57 @@ LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& curr
       if (k + 1 == starts.size()) throw;
     }
   }
+}
+
+// The screening's verdict on a candidate: true (and its predicted figures
+// in c) if it cannot pass the acceptance, so that it is not refitted. A
+// candidate the screening cannot replay from any start is left to the
+// full path, which skips it and says why.
+bool screen_out(const Dataset& dataset, const LeastSquaresResult& current, double current_heldout,
+                const std::vector<FitParameter>& parameters, const DiagnoseOptions& options, CandidateFit& c) {
+  if (current.active.empty() || current.jacobian.cols() != static_cast<Eigen::Index>(current.active.size()))
+    return false;
+  for (const ModelParams& start : candidate_starts(current.params, c.effects, parameters, c.added)) {
+    ScreeningPrediction p;
+    try {
+      p = screen_effect(dataset, current, parameters, start, c.added, options.fit.least_squares);
+    } catch (const std::exception&) {
+      continue;
+    }
+    // From a start the step cannot bring back to the current fit (an effect
+    // whose start is far from neutral), the linearisation says nothing.
+    if (!(p.sum_sq_mm2 <= current.sum_sq_mm2)) return false;
+    LeastSquaresResult predicted;
+    predicted.params = p.params;
+    predicted.residual_count = p.residual_count;
+    predicted.free_parameters = p.free_parameters;
+    predicted.sum_sq_mm2 = p.sum_sq_mm2;
+    predicted.rmse_mm = p.rmse_mm;
+    predicted.termination = "screened: one Gauss-Newton step predicted, not refitted";
+    const double ratio = p.reference_heldout_rmse_mm > 0.0 ? p.heldout_rmse_mm / p.reference_heldout_rmse_mm : 1.0;
+    const double gain = 1.0 - ratio;
+    const double delta_bic = bic(predicted) - bic(current);
+    c.screened = true;
+    c.predicted_rmse_mm = p.rmse_mm;
+    c.predicted_heldout_rmse_mm = current_heldout * ratio;
+    c.predicted_delta_bic = delta_bic;
+    if (gain >= options.screen_margin * options.min_heldout_gain && delta_bic < options.screen_margin * options.max_delta_bic)
+      return false;
+    char note[200];
+    std::snprintf(note, sizeof note,
+                  "predicted held-out gain %.2f %% (needs %.2f %% to be refitted), predicted delta BIC %.1f "
+                  "(needs < %.1f)",
+                  100.0 * gain, 100.0 * options.screen_margin * options.min_heldout_gain, delta_bic,
+                  options.screen_margin * options.max_delta_bic);
+    c.fit = std::move(predicted);
+    c.heldout_rmse_mm = current_heldout * ratio;
+    c.delta_bic = delta_bic;
+    c.significant = false;
+    c.screened_out = true;
+    c.screening_note = note;
+    return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -106,6 +163,15 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
       c.effects.push_back(effect);
       c.added = effect;
       const auto parameters = fit_parameters(c.effects);
+      if (options.screening) {
+        if (progress) progress("screening " + effect, 0, 1, "");
+        const bool out_of_the_running = screen_out(dataset, current, current_heldout, parameters, options, c);
+        if (progress) progress("screening " + effect, 1, 1, out_of_the_running ? "screened out" : "refit");
+        if (out_of_the_running) {
+          fits.push_back(std::move(c));
+          continue;
+        }
+      }
       // Warm start: the current model's optimum, the new effect at its
       // defaults. A candidate the model cannot replay is skipped and said so.
       try {

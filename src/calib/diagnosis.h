@@ -11,6 +11,7 @@
 #include "calib/cross_validation.h"
 #include "calib/fit_model.h"
 #include "calib/residual_pattern.h"
+#include "calib/screening.h"
 
 namespace hj {
 
@@ -22,6 +23,13 @@ struct DiagnoseOptions {
   // current model's AND delta BIC is below max_delta_bic (see diagnosis.cc).
   double min_heldout_gain = 0.01;
   double max_delta_bic = -10.0;
+  // Screening (screening.h): a candidate is refitted and cross-validated
+  // only if its predicted held-out gain is at least screen_margin *
+  // min_heldout_gain and its predicted delta BIC below screen_margin *
+  // max_delta_bic (the margin allows for the linearisation's error); the
+  // others keep their predicted figures. false: refit every candidate.
+  bool screening = true;
+  double screen_margin = 0.5;
 };
 
 struct CandidateFit {
@@ -31,6 +39,12 @@ struct CandidateFit {
   double heldout_rmse_mm = 0.0;
   double delta_bic = 0.0;            // against the model it extends
   bool significant = false;
+  // Not refitted: fit.params, fit.rmse_mm, heldout_rmse_mm and delta_bic
+  // are the screening's predictions, and screening_note says why.
+  bool screened_out = false;
+  std::string screening_note;
+  bool screened = false;  // the screening's predictions below exist
+  double predicted_rmse_mm = 0.0, predicted_heldout_rmse_mm = 0.0, predicted_delta_bic = 0.0;
 };
 
 struct LadderStep {
