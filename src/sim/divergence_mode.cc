@@ -1,7 +1,7 @@
 #include "sim/divergence_mode.h"
 
 #include <Eigen/SparseCholesky>
-#include <Eigen/SparseLU>
+#include <Eigen/UmfPackSupport>
 #include <cmath>
 
 namespace hj {
@@ -20,7 +20,9 @@ Eigen::VectorXd divergence_mode(const Eigen::SparseMatrix<double>& stiffness) {
   const double scale = sym.diagonal().cwiseAbs().maxCoeff();
   Eigen::SparseMatrix<double> shifted = stiffness;
   for (int i = 0; i < shifted.rows(); ++i) shifted.coeffRef(i, i) += 1e-9 * scale;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(shifted);
+  Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu;
+  lu.umfpackControl()(UMFPACK_IRSTEP) = 0;
+  lu.compute(shifted);
   if (lu.info() != Eigen::Success) return {};
   // Start mostly out of plane (where the net creases), in plane a little.
   Eigen::VectorXd v = Eigen::VectorXd::Constant(sym.rows(), 0.1);

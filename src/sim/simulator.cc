@@ -44,14 +44,14 @@ void Simulator::settle_once() {
     return;
   }
   const Eigen::Matrix3Xd before = state_.x;
-  last_ = settle_static(model_, state_, options_.static_options);
+  last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
   if (last_.converged) return;
   // Safe fallback: relax dynamically from the previous state, then polish.
   state_.x = before;
   ExplicitEulerOptions fallback = options_.explicit_options;
   fallback.max_steps = std::min(fallback.max_steps, options_.fallback_max_steps);
   const SettleReport dynamic = settle_explicit(model_, state_, fallback);
-  last_ = settle_static(model_, state_, options_.static_options);
+  last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
   last_.iterations += dynamic.iterations;
   last_.seconds += dynamic.seconds;
 }

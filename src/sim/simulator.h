@@ -69,6 +69,7 @@ class Simulator {
   ForceModel model_;
   DeviceState state_;
   SettleReport last_;
+  SettleMemory settle_memory_;
 };
 
 // Parses "static" / "explicit"; std::invalid_argument otherwise.

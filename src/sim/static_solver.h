@@ -44,8 +44,17 @@ struct StaticSolverOptions {
   void validate() const;
 };
 
+// What one settle leaves for the next on the same device: the divergence
+// mode last pushed along without reaching another equilibrium. The next
+// settle does not push along the same mode again (a large dome's slow shear
+// mode otherwise costs push_iterations at every action on it).
+struct SettleMemory {
+  Eigen::VectorXd marginal_mode;  // unit, over the free DOFs of that settle
+};
+
 // Settles state.x in place from where it is. Never throws on a hard case:
 // returns converged = false, leaving the best state found.
-SettleReport settle_static(const ForceModel& model, DeviceState& state, const StaticSolverOptions& options = {});
+SettleReport settle_static(const ForceModel& model, DeviceState& state, const StaticSolverOptions& options = {},
+                           SettleMemory* memory = nullptr);
 
 }  // namespace hj
