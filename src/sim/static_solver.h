@@ -4,8 +4,11 @@
 //   (K + mu I) dx = F,   K = -dF/dx (analytic, sparse), mu = c / dt,
 // so it starts as a heavily damped relaxation from the previous state and
 // ends as Newton. mu follows one of two controls (static_solver.cc): a fast
-// one that keeps each move near the cap, tried first, and a careful one that
-// shrinks mu only while the linear model predicts the residual; where that
+// one that keeps each move near the cap, tried first (and given up once its
+// residual runs away), and a careful one that shrinks mu only while the
+// linear model predicts the residual, judged in the compliance-weighted
+// norm |(K + mu I)^-1 r| so the stiff springs of jammed cells do not veto
+// every step; where that
 // does not settle either, the careful one again with curved steps (geodesic
 // acceleration, for jammed cells turning on a soft net). A converged
 // state along which K diverges (divergence_mode.h: a saddle, or the creased
