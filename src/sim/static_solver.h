@@ -8,9 +8,9 @@
 // residual runs away), and a careful one that shrinks mu only while the
 // linear model predicts the residual, judged in the compliance-weighted
 // norm |(K + mu I)^-1 r| so the stiff springs of jammed cells do not veto
-// every step; where that
-// does not settle either, the careful one again with curved steps (geodesic
-// acceleration, for jammed cells turning on a soft net). A converged
+// every step. Where that does not settle either, the careful one runs again
+// with curved steps (geodesic acceleration, for jammed cells turning on a
+// soft net). A converged
 // state along which K diverges (divergence_mode.h: a saddle, or the creased
 // net near levelling) is pushed along that mode and settled again; a push
 // that reaches no other equilibrium within push_iterations goes back, and
