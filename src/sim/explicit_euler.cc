@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "sim/process_tuning.h"
+
 namespace hj {
 
 void ExplicitEulerOptions::validate() const {
@@ -32,6 +34,7 @@ double explicit_time_step(const ForceModel& model, const ExplicitEulerOptions& o
 
 SettleReport settle_explicit(const ForceModel& model, DeviceState& state, const ExplicitEulerOptions& options) {
   options.validate();
+  tune_process_for_settling();
   const auto start = std::chrono::steady_clock::now();
   const Mesh& mesh = model.mesh();
   const std::vector<char> fixed = model.fixed_points(state);
