@@ -3,10 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
-#include <mutex>
-#include <optional>
 #include <thread>
 
 #include "calib/calibration_json.h"
@@ -16,6 +12,7 @@
 #include "dataset_upload.h"
 #include "request_context.h"
 #include "service_error.h"
+#include "streamed_work.h"
 
 namespace hj::server {
 
@@ -30,38 +27,6 @@ constexpr int kMaxIterationsLimit = 1000;
 
 using StageProgress = std::function<void(const std::string& stage, int done, int total, const std::string& detail)>;
 
-// What a worker and the handler share (as in planning_service.cc): the
-// progress events the worker produced, its final status and result, and the
-// flag that stops it. Shared, so a handler whose caller went away can return
-// while its task still waits in the queue.
-template <class Event>
-struct Work {
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::deque<Event> events;
-  std::optional<grpc::Status> done;
-  std::optional<Event> result;
-  std::atomic<bool> stop{false};
-  Clock::time_point deadline = Clock::time_point::max();
-
-  void push(Event event) {
-    std::lock_guard lock(mutex);
-    events.push_back(std::move(event));
-    changed.notify_all();
-  }
-  void finish(grpc::Status status, std::optional<Event> r = std::nullopt) {
-    std::lock_guard lock(mutex);
-    done = std::move(status);
-    result = std::move(r);
-    changed.notify_all();
-  }
-  bool should_stop() const { return stop || Clock::now() > deadline; }
-  grpc::Status stopped_status() const {
-    return Clock::now() > deadline ? grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, "the caller's deadline passed")
-                                   : grpc::Status(grpc::StatusCode::CANCELLED, "the caller cancelled");
-  }
-};
-
 // The library's work for one call: given the flag to poll and where to
 // report progress, returns the result event.
 template <class Event>
@@ -69,15 +34,13 @@ using Compute = std::function<Event(const std::function<bool()>& interrupted, co
 
 // Runs `compute` on the pool and relays its progress to `writer`, then its
 // result (also returned in `last`). Stops the work when the caller cancels
-// or its deadline passes (polled every 20 ms).
+// or its deadline passes (streamed_work.h).
 template <class Event>
 grpc::Status run_streamed(grpc::ServerContext* context, grpc::ServerWriter<Event>* writer, WorkPool& pool,
-                          Compute<Event> compute, Event& last) {
-  auto work = std::make_shared<Work<Event>>();
-  if (context->deadline() != std::chrono::system_clock::time_point::max())
-    work->deadline = Clock::now() + (context->deadline() - std::chrono::system_clock::now());
-  auto task = [work, compute = std::move(compute)] {
-    if (work->should_stop()) return work->finish(work->stopped_status());
+                          Compute<Event> compute, const std::string& what, Event& last) {
+  auto work = std::make_shared<StreamedWork<Event, Event>>(*context);
+  auto task = [work, what, compute = std::move(compute)] {
+    if (work->should_stop()) return work->finish(work->stopped_status(what));
     try {
       const StageProgress progress = [&](const std::string& stage, int done, int total, const std::string& detail) {
         Event event;
@@ -89,10 +52,9 @@ grpc::Status run_streamed(grpc::ServerContext* context, grpc::ServerWriter<Event
         if (const auto rmse = rmse_of_detail(detail)) p->set_rmse_mm(*rmse);
         work->push(std::move(event));
       };
-      Event result = compute([work] { return work->should_stop(); }, progress);
-      work->finish(grpc::Status::OK, std::move(result));
+      work->finish(grpc::Status::OK, compute([work] { return work->should_stop(); }, progress));
     } catch (const SettleInterrupted&) {
-      work->finish(work->stopped_status());
+      work->finish(work->stopped_status(what));
     } catch (const SessionError& e) {
       // A replay that fails names the session and step: the data's problem.
       work->finish({grpc::StatusCode::INVALID_ARGUMENT, e.what()});
@@ -104,32 +66,9 @@ grpc::Status run_streamed(grpc::ServerContext* context, grpc::ServerWriter<Event
     return {grpc::StatusCode::RESOURCE_EXHAUSTED,
             "work queue full: " + std::to_string(pool.workers()) + " workers busy and " +
                 std::to_string(pool.queue_size()) + " requests waiting (--workers, --queue-size)"};
-
-  std::unique_lock lock(work->mutex);
-  for (;;) {
-    work->changed.wait_for(lock, std::chrono::milliseconds(20),
-                           [&] { return work->done.has_value() || !work->events.empty(); });
-    while (!work->events.empty()) {
-      Event event = std::move(work->events.front());
-      work->events.pop_front();
-      lock.unlock();
-      const bool written = writer->Write(event);
-      lock.lock();
-      if (!written) work->stop = true;
-    }
-    if (work->done) break;
-    if (Clock::now() > work->deadline) {
-      work->stop = true;
-      return {grpc::StatusCode::DEADLINE_EXCEEDED, "the caller's deadline passed before the work was done"};
-    }
-    if (context->IsCancelled()) {
-      work->stop = true;
-      return {grpc::StatusCode::CANCELLED, "the caller cancelled"};
-    }
-  }
-  if (!work->done->ok()) return *work->done;
-  last = std::move(*work->result);
-  lock.unlock();
+  const grpc::Status status = relay_until_done(context, writer, *work, what);
+  if (!status.ok()) return status;
+  last = std::move(work->result);
   if (!writer->Write(last)) return {grpc::StatusCode::CANCELLED, "the caller went away"};
   return grpc::Status::OK;
 }
@@ -252,7 +191,7 @@ grpc::Status CalibrationServiceImpl::Compare(grpc::ServerContext* context, const
       return event;
     };
     v1::CompareEvent last;
-    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), last);
+    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), "the comparison", last);
     if (!status.ok()) throw ServiceError(status.error_code(), status.error_message());
     rc.note("rmse_mm", last.result().rmse_mm());
   });
@@ -308,7 +247,7 @@ grpc::Status CalibrationServiceImpl::Fit(grpc::ServerContext* context, const v1:
       return event;
     };
     v1::FitEvent last;
-    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), last);
+    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), "the fit", last);
     if (!status.ok()) throw ServiceError(status.error_code(), status.error_message());
     rc.note("rmse_mm", last.result().rmse_mm());
   });
@@ -355,7 +294,7 @@ grpc::Status CalibrationServiceImpl::Diagnose(grpc::ServerContext* context, cons
       return event;
     };
     v1::DiagnoseEvent last;
-    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), last);
+    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), "the diagnosis", last);
     if (!status.ok()) throw ServiceError(status.error_code(), status.error_message());
     rc.note("verdict", list(last.result().verdict()));
   });
