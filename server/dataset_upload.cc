@@ -101,7 +101,12 @@ Dataset dataset_from_upload(const v1::UploadedDataset& upload, const ServerLimit
       const fs::path relative = checked_relative(s.files(f).path(), file_where);
       if (!paths.insert(relative.lexically_normal()).second)
         refuse(file_where + ": \"" + s.files(f).path() + "\" uploaded twice (or is session.json)");
-      write_file(dir / relative, s.files(f).content());
+      try {
+        write_file(dir / relative, s.files(f).content());
+      } catch (const fs::filesystem_error&) {
+        // e.g. "frames" uploaded as a file and "frames/000.csv" too
+        refuse(file_where + ": \"" + s.files(f).path() + "\" cannot be stored: one of its folders is an uploaded file");
+      }
     }
   }
   try {

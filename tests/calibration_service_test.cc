@@ -290,6 +290,12 @@ TEST_F(CalibrationService, AMalformedUploadIsRefusedNamingTheFileAndKey) {
     r.mutable_dataset()->mutable_sessions(0)->mutable_files(0)->set_path("../../escape.csv");
     expect_refused(r, {"tiny/jammed files[0]", "../../escape.csv", "relative path"});
   }
+  {  // a file where a folder of another is
+    v1::CompareRequest r = compare_request(dataset_dir());
+    v1::SessionFile* clash = r.mutable_dataset()->mutable_sessions(0)->add_files();
+    clash->set_path("frames/000.csv/x.csv");
+    expect_refused(r, {"tiny/jammed files[2]", "frames/000.csv/x.csv"});
+  }
   {  // a broken params document
     v1::CompareRequest r = compare_request(dataset_dir());
     r.mutable_options()->set_params_json(R"({"format": "hapticjam.params/1", "surface": {"mass_kg": -1}})");
