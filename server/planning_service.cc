@@ -1,10 +1,6 @@
 #include "planning_service.h"
 
 #include <chrono>
-#include <condition_variable>
-#include <deque>
-#include <mutex>
-#include <optional>
 
 #include "calib/step_json.h"
 #include "json_log.h"
@@ -21,32 +17,6 @@ using Clock = std::chrono::steady_clock;
 // Preview's mesh when the request leaves array.segments unset: planning
 // time grows steeply with the segments (6 x 8 cells: ~2 s at 2, minutes at 4).
 constexpr int kPreviewSegments = 2;
-
-// What a worker and the handler share: events the worker produced, its final
-// status, and the flag that stops it. Shared, so a handler whose caller went
-// away can return while its task still waits in the queue.
-struct PlanningServiceImpl::Work {
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::deque<v1::PlanEvent> events;
-  std::optional<grpc::Status> done;
-  std::shared_ptr<const v1::PlanResult> result;
-  std::atomic<bool> stop{false};
-  Clock::time_point deadline = Clock::time_point::max();
-
-  void push(v1::PlanEvent event) {
-    std::lock_guard lock(mutex);
-    events.push_back(std::move(event));
-    changed.notify_all();
-  }
-  void finish(grpc::Status status, std::shared_ptr<const v1::PlanResult> r = nullptr) {
-    std::lock_guard lock(mutex);
-    done = std::move(status);
-    result = std::move(r);
-    changed.notify_all();
-  }
-  bool should_stop() const { return stop || Clock::now() > deadline; }
-};
 
 namespace {
 
@@ -95,9 +65,7 @@ grpc::Status PlanningServiceImpl::plan_or_cached(grpc::ServerContext* context, c
     return grpc::Status::OK;
   }
 
-  auto work = std::make_shared<Work>();
-  if (context->deadline() != std::chrono::system_clock::time_point::max())
-    work->deadline = Clock::now() + (context->deadline() - std::chrono::system_clock::now());
+  auto work = std::make_shared<Work>(*context);
   const bool streaming = writer != nullptr;
   auto task = [work, request, snapshots, streaming, key, &maps = maps_, &limits = limits_, &cache = cache_] {
     if (work->should_stop()) return work->finish({grpc::StatusCode::CANCELLED, "cancelled before it started"});
@@ -127,9 +95,7 @@ grpc::Status PlanningServiceImpl::plan_or_cached(grpc::ServerContext* context, c
       cache.insert(key, result);
       work->finish(grpc::Status::OK, std::move(result));
     } catch (const PlanCancelled&) {
-      work->finish(Clock::now() > work->deadline
-                       ? grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, "deadline passed while planning")
-                       : grpc::Status(grpc::StatusCode::CANCELLED, "planning was cancelled"));
+      work->finish(work->stopped_status("planning"));
     } catch (...) {
       work->finish(status_from_current_exception());
     }
@@ -139,30 +105,8 @@ grpc::Status PlanningServiceImpl::plan_or_cached(grpc::ServerContext* context, c
             "planning queue full: " + std::to_string(pool_.workers()) + " workers busy and " +
                 std::to_string(pool_.queue_size()) + " requests waiting (--workers, --queue-size)"};
 
-  // Relay events until the work is done; stop it if the caller goes away.
-  std::unique_lock lock(work->mutex);
-  for (;;) {
-    work->changed.wait_for(lock, std::chrono::milliseconds(20),
-                           [&] { return work->done.has_value() || !work->events.empty(); });
-    while (writer && !work->events.empty()) {
-      v1::PlanEvent event = std::move(work->events.front());
-      work->events.pop_front();
-      lock.unlock();
-      const bool written = writer->Write(event);
-      lock.lock();
-      if (!written) work->stop = true;
-    }
-    if (work->done) break;
-    if (Clock::now() > work->deadline) {
-      work->stop = true;
-      return {grpc::StatusCode::DEADLINE_EXCEEDED, "the caller's deadline passed before the plan was done"};
-    }
-    if (context->IsCancelled()) {
-      work->stop = true;
-      return {grpc::StatusCode::CANCELLED, "the caller cancelled"};
-    }
-  }
-  if (!work->done->ok()) return *work->done;
+  const grpc::Status status = relay_until_done(context, writer, *work, "the plan");
+  if (!status.ok()) return status;
   *result = *work->result;
   result->set_seconds(std::chrono::duration<double>(Clock::now() - start).count());
   return grpc::Status::OK;

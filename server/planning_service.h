@@ -9,6 +9,7 @@
 #include "hapticjam/v1/planning_service.grpc.pb.h"
 #include "server_limits.h"
 #include "result_cache.h"
+#include "streamed_work.h"
 #include "work_pool.h"
 
 namespace hj::server {
@@ -27,7 +28,7 @@ class PlanningServiceImpl final : public hapticjam::v1::PlanningService::Service
                             hapticjam::v1::ListPlannersResponse* response) override;
 
  private:
-  struct Work;
+  using Work = StreamedWork<hapticjam::v1::PlanEvent, std::shared_ptr<const hapticjam::v1::PlanResult>>;
   // Plans (or finds in the cache) and returns the result; streams events to
   // `writer` when it is set.
   grpc::Status plan_or_cached(grpc::ServerContext* context, const hapticjam::v1::PreviewRequest& request,

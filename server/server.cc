@@ -16,6 +16,7 @@ namespace {
 
 constexpr const char* kPlanningService = "hapticjam.v1.PlanningService";
 constexpr const char* kDeviceService = "hapticjam.v1.DeviceService";
+constexpr const char* kCalibrationService = "hapticjam.v1.CalibrationService";
 
 std::string read_file(const std::string& path, const char* flag) {
   std::ifstream in(path, std::ios::binary);
@@ -51,6 +52,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   pool_ = std::make_unique<WorkPool>(options_.worker_count(), options_.queue_size);
   planning_ = std::make_unique<PlanningServiceImpl>(auth_, maps_, options_.limits, *pool_, *cache_);
   device_ = std::make_unique<DeviceServiceImpl>(auth_, *queue_);
+  calibration_ = std::make_unique<CalibrationServiceImpl>(auth_, options_.limits, *pool_);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -59,6 +61,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   builder.SetMaxReceiveMessageSize(options_.limits.max_message_bytes);
   builder.RegisterService(planning_.get());
   builder.RegisterService(device_.get());
+  builder.RegisterService(calibration_.get());
   server_ = builder.BuildAndStart();
   if (!server_ || port_ == 0)
     throw std::runtime_error("cannot listen on " + options_.listen + " (address in use or not valid?)");
@@ -67,6 +70,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
     serving_ = true;
   }
   server_->GetHealthCheckService()->SetServingStatus(kPlanningService, true);
+  server_->GetHealthCheckService()->SetServingStatus(kCalibrationService, true);
   queue_->start([this](bool connected) { set_device_health(connected); });
   log_event("server_started", {{"listen", options_.listen},
                                {"port", port_},

@@ -1,5 +1,5 @@
-// The whole server in one object: gRPC services (planning, device, health,
-// reflection) over the work pool, result cache, job store and device queue.
+// The whole server in one object: gRPC services (planning, device,
+// calibration, health, reflection) over the work pool, result cache, job store and device queue.
 // main.cc only parses flags, opens the device link and waits for a signal;
 // tests start one in-process on a loopback port 0.
 #pragma once
@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "auth.h"
+#include "calibration_service.h"
 #include "device/device_link.h"
 #include "device_queue.h"
 #include "device_service.h"
@@ -58,6 +59,7 @@ class HapticServer {
   std::unique_ptr<WorkPool> pool_;
   std::unique_ptr<PlanningServiceImpl> planning_;
   std::unique_ptr<DeviceServiceImpl> device_;
+  std::unique_ptr<CalibrationServiceImpl> calibration_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
 

@@ -18,6 +18,9 @@ struct ServerLimits {
   int max_mesh_points = 200'000;
   // Steps in one device job.
   int max_job_steps = 100'000;
+  // An uploaded dataset (CalibrationService): sessions, and files in all.
+  int max_upload_sessions = 1'000;
+  long max_upload_files = 100'000;
 };
 
 }  // namespace hj::server

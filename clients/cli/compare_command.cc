@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "args.h"
+#include "calib/calibration_json.h"
 #include "calib/diagnosis.h"
 #include "calib_args.h"
 #include "html_report.h"
@@ -46,13 +47,7 @@ int compare(const CalibArgs& args) {
   const std::filesystem::path out(args.out);
   const double floor = noise_floor_mm(dataset);
 
-  nlohmann::json summary = {{"rmse_mm", evaluation.rmse_mm()},
-                            {"mae_mm", evaluation.mae_mm()},
-                            {"samples", evaluation.samples},
-                            {"noise_floor_mm", floor},
-                            {"params", model_params_json(params)},
-                            {"sessions", nlohmann::json::array()},
-                            {"cells", nlohmann::json::array()}};
+  nlohmann::json summary = compare_summary_json(dataset, params, evaluation);
   HtmlReport report("hapticjam compare: " + dataset.dir.filename().string());
   report.paragraph("Model: " + model_params_json(params).dump());
   report.paragraph("Over all " + std::to_string(evaluation.samples) + " compared samples: RMSE " +
@@ -67,7 +62,6 @@ int compare(const CalibArgs& args) {
   std::string figures;
   for (size_t s = 0; s < dataset.sessions.size(); ++s) {
     const MeasuredSession& measured = dataset.sessions[s];
-    nlohmann::json captures = nlohmann::json::array();
     for (size_t c = 0; c < measured.captures.size(); ++c) {
       const MeasuredCapture& capture = measured.captures[c];
       const CaptureError& e = evaluation.sessions[s].captures[c];
@@ -77,19 +71,7 @@ int compare(const CalibArgs& args) {
                                 number(capture.pressure_pa / 1000.0, "%.3g") + " kPa): RMSE " + number(e.rmse_mm(), "%.2f") + " mm";
       write_residual_png(out / image, measured.session, e.residual_mm, args.scale_mm, capture.pinned, title);
       images.update(++done_images, total_images, image);
-      captures.push_back({{"frame", capture.frame},
-                          {"label", capture.label},
-                          {"pressure_kpa", capture.pressure_pa / 1000.0},
-                          {"jammed_cells", capture.jammed_count()},
-                          {"pinned_nodes", capture.pinned.size()},
-                          {"rmse_mm", e.rmse_mm()},
-                          {"mae_mm", e.mae_mm()},
-                          {"max_mm", e.max_mm},
-                          {"mean_mm", e.mean_mm},
-                          {"within_accuracy", e.share_within_accuracy()},
-                          {"samples", e.samples},
-                          {"uncovered", e.uncovered},
-                          {"image", image}});
+      summary["sessions"][s]["captures"][c]["image"] = image;
       rows.push_back({measured.session.name, capture.frame, capture.label, number(capture.pressure_pa / 1000.0),
                       std::to_string(capture.jammed_count()), number(e.rmse_mm()), number(e.mae_mm()),
                       number(e.max_mm), number(100.0 * e.share_within_accuracy(), "%.1f %%")});
@@ -98,7 +80,6 @@ int compare(const CalibArgs& args) {
       figures += "<figure><img src='" + html_escape(image) + "' width='420'><figcaption>" + html_escape(title) +
                  "</figcaption></figure>\n";
     }
-    summary["sessions"].push_back({{"name", measured.session.name}, {"captures", captures}});
   }
   images.finish();
   const Eigen::MatrixXd cells = evaluation.cell_rmse_mm();
@@ -108,9 +89,6 @@ int compare(const CalibArgs& args) {
     for (int c = 0; c < cells.cols(); ++c) row.push_back(number(cells(r, c), "%.2f"));
     cell_rows.push_back(row);
   }
-  for (int r = 0; r < cells.rows(); ++r)
-    for (int c = 0; c < cells.cols(); ++c)
-      summary["cells"].push_back({{"cell", {r, c}}, {"rmse_mm", cells(r, c)}, {"samples", evaluation.cell_samples(r, c)}});
   write_json(out / "summary.json", summary);
 
   std::vector<std::string> cell_header{""};

@@ -28,24 +28,6 @@ constexpr const char* kDiagnoseUsage =
     "  --no-screening  refit every candidate (default: only those whose predicted gain, from one\n"
     "                  Gauss-Newton step at the current optimum, could pass; see README)\n";
 
-nlohmann::json candidate_json(const CandidateFit& c) {
-  nlohmann::json j = {{"effect", c.added},
-          {"effects", c.effects},
-          {"rmse_mm", c.fit.rmse_mm},
-          {"heldout_rmse_mm", c.heldout_rmse_mm},
-          {"delta_bic", c.delta_bic},
-          {"significant", c.significant},
-          {"screened_out", c.screened_out},
-          {"params", model_params_json(c.fit.params)},
-          {"uncertainties", uncertainties_json(c.fit)}};
-  if (c.screened_out) j["screening"] = c.screening_note;
-  if (c.screened)
-    j["predicted"] = {{"rmse_mm", c.predicted_rmse_mm},
-                      {"heldout_rmse_mm", c.predicted_heldout_rmse_mm},
-                      {"delta_bic", c.predicted_delta_bic}};
-  return j;
-}
-
 std::string num(double v, const char* format = "%.3f") {
   char b[32];
   std::snprintf(b, sizeof b, format, v);
@@ -71,33 +53,9 @@ int diagnose_dataset(const CalibArgs& args) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
 
-  nlohmann::json ranking = nlohmann::json::array(), later = nlohmann::json::array(), worst = nlohmann::json::array();
-  for (const auto& c : d.ranking) ranking.push_back(candidate_json(c));
-  for (const auto& c : d.later_rounds) later.push_back(candidate_json(c));
-  for (auto [r, c] : d.pattern.worst_cells) worst.push_back({r, c});
-  nlohmann::json ladder = nlohmann::json::array();
-  for (const auto& step : d.ladder)
-    ladder.push_back({{"model", step.label}, {"rmse_mm", step.rmse_mm}, {"heldout_rmse_mm", step.heldout_rmse_mm}});
   const LeastSquaresResult& base = d.baseline.joint;
-  const nlohmann::json doc = {
-      {"baseline",
-       {{"rmse_mm", base.rmse_mm},
-        {"heldout_rmse_mm", d.baseline_heldout_rmse_mm},
-        {"r2", base.r2},
-        {"params", model_params_json(base.params)},
-        {"uncertainties", uncertainties_json(base)}}},
-      {"ranking", ranking},
-      {"later_rounds", later},
-      {"verdict", d.verdict},
-      {"worst_cells", worst},
-      {"findings", d.pattern.findings},
-      {"skipped", d.skipped},
-      {"ladder", ladder},
-      {"noise_floor_mm", d.noise_floor_mm},
-      {"final_params", model_params_json(d.final_params)},
-      {"seconds", seconds},
-      {"cpu_seconds", cpu_seconds},
-      {"timing", progress.timing()}};
+  nlohmann::json doc = diagnosis_json(d);
+  doc.update({{"seconds", seconds}, {"cpu_seconds", cpu_seconds}, {"timing", progress.timing()}});
   const std::filesystem::path out(args.out);
   write_json(out / "diagnosis.json", doc);
   write_model_params(out / "params.json", d.final_params, {{"verdict", d.verdict}});

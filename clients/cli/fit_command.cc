@@ -62,41 +62,10 @@ int fit(const CalibArgs& args) {
   }
   progress.finish();
   const std::vector<std::string> notes = loose_notes(joint);
-  nlohmann::json levelling = {{"found", report.levelling.found}};
-  if (report.levelling.found)
-    levelling.update({{"pressure_pa", report.levelling.pressure_pa},
-                      {"mass_kg", report.levelling.mass_kg},
-                      {"session", report.levelling.session},
-                      {"between_pa", {report.levelling.below_pa, report.levelling.above_pa}},
-                      {"pressure_ci95_pa", {report.levelling.pressure_low_pa, report.levelling.pressure_high_pa}},
-                      {"mass_ci95_kg", {report.levelling.mass_low_kg, report.levelling.mass_high_kg}},
-                      {"points", report.levelling.points},
-                      {"scatter_mm", report.levelling.scatter_mm}});
-  nlohmann::json algorithm1 = nlohmann::json::object();
-  for (const auto& s : report.stiffnesses)
-    algorithm1[s.parameter] = {{"value", s.result.value},
-                               {"bracketed", s.result.bracketed},
-                               {"captures", s.result.captures},
-                               {"evaluations", s.result.evaluations}};
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
-  const nlohmann::json extra = {{"rmse_mm", joint.rmse_mm},
-                                {"r2", joint.r2},
-                                {"samples", joint.residual_count},
-                                {"noise_floor_mm", noise_floor_mm(all)},
-                                {"uncertainties", uncertainties_json(joint)},
-                                {"notes", notes},
-                                {"heldout", heldout},
-                                {"levelling", levelling},
-                                {"algorithm1", algorithm1},
-                                {"least_squares", {{"iterations", joint.iterations},
-                                                   {"jacobians", joint.jacobians},
-                                                   {"evaluations", joint.evaluations},
-                                                   {"termination", joint.termination}}},
-                                {"dataset", all.dir.string()},
-                                {"seconds", seconds},
-                                {"cpu_seconds", cpu_seconds},
-                                {"timing", progress.timing()}};
+  nlohmann::json extra = fit_extra_json(all, report, heldout, all.dir.string());
+  extra.update({{"seconds", seconds}, {"cpu_seconds", cpu_seconds}, {"timing", progress.timing()}});
   const std::filesystem::path out(args.out);
   write_model_params(out / "params.json", joint.params, extra);
 

@@ -17,6 +17,7 @@ const std::vector<Subcommand> kSubcommands = {
     {"submit", run_remote_submit}, {"watch", run_remote_watch},     {"job", run_remote_job},
     {"cancel", run_remote_cancel}, {"status", run_remote_status},   {"stop", run_remote_stop},
     {"resume", run_remote_resume}, {"bench", run_remote_bench},
+    {"compare", run_remote_compare}, {"fit", run_remote_fit},       {"diagnose", run_remote_diagnose},
 };
 
 constexpr const char* kRemoteUsage =
@@ -33,6 +34,7 @@ constexpr const char* kRemoteUsage =
     "  stop [--reason TEXT]         emergency stop: vent the device now, pause the queue\n"
     "  resume                       let a paused queue run again\n"
     "  bench                        Preview calls per second and latency\n"
+    "  compare|fit|diagnose DATASET --out DIR   the measurement workbench on the server\n"
     "Exit codes: 0 done, 2 usage, 10 + the gRPC status code when the server refuses\n"
     "(13 INVALID_ARGUMENT, 17 PERMISSION_DENIED, 18 RESOURCE_EXHAUSTED, 19 FAILED_PRECONDITION,\n"
     "24 UNAVAILABLE, 26 UNAUTHENTICATED ...). 'hapticjam remote SUBCOMMAND --help' for options.\n";

@@ -26,4 +26,8 @@ int run_remote_resume(const std::vector<std::string>& args);
 
 int run_remote_bench(const std::vector<std::string>& args);
 
+int run_remote_compare(const std::vector<std::string>& args);
+int run_remote_fit(const std::vector<std::string>& args);
+int run_remote_diagnose(const std::vector<std::string>& args);
+
 }  // namespace hj::cli

@@ -55,6 +55,8 @@ LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& curr
   for (size_t k = 0;; ++k) {
     try {
       return fit_least_squares(dataset, starts[k], parameters, options.fit.least_squares, progress);
+    } catch (const SettleInterrupted&) {
+      throw;  // the caller stopped the work: not a failed replay
     } catch (const std::exception&) {
       if (k + 1 == starts.size()) throw;
     }
@@ -73,6 +75,8 @@ bool screen_out(const Dataset& dataset, const LeastSquaresResult& current, doubl
     ScreeningPrediction p;
     try {
       p = screen_effect(dataset, current, parameters, start, c.added, options.fit.least_squares);
+    } catch (const SettleInterrupted&) {
+      throw;  // the caller stopped the work: not a failed replay
     } catch (const std::exception&) {
       continue;
     }
@@ -177,13 +181,13 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
       try {
         c.fit = fit_candidate(dataset, current.params, c.effects, parameters, effect, options,
                               [&](int iteration, int max_iterations, double rmse) {
-                                char detail[64];
-                                std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
-                                if (progress) progress(stage, iteration, max_iterations, detail);
+                                if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
                               });
         c.heldout_rmse_mm = cross_validate(dataset, parameters, c.fit, replay).heldout_rmse_mm;
         c.delta_bic = bic(c.fit) - bic(current);
         c.significant = is_significant(c, current_heldout, options);
+      } catch (const SettleInterrupted&) {
+        throw;  // the caller stopped the work: not a failed replay
       } catch (const std::exception& e) {
         out.skipped.push_back(effect + ": " + e.what());
         continue;

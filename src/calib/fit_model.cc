@@ -32,18 +32,31 @@ void refine_on_bare_captures(const Dataset& dataset, const std::vector<FitParame
   try {
     const LeastSquaresResult r =
         fit_least_squares(bare, out.initial, surface, options.least_squares, [&](int iteration, int max, double rmse) {
-          char detail[64];
-          std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
-          if (progress) progress("least squares on the bare captures", iteration, max, detail);
+          if (progress) progress("least squares on the bare captures", iteration, max, rmse_detail(rmse));
         });
     out.initial = r.params;
     out.bare_rmse_mm = r.rmse_mm;
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
   } catch (const std::exception&) {
     // Keep the estimates so far; the joint fit starts from them.
   }
 }
 
 }  // namespace
+
+std::string rmse_detail(double rmse_mm) {
+  char detail[64];
+  std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse_mm);
+  return detail;
+}
+
+std::optional<double> rmse_of_detail(const std::string& detail) {
+  double rmse = 0.0;
+  char unit[4] = {};
+  if (std::sscanf(detail.c_str(), "RMSE %lf %3s", &rmse, unit) == 2 && std::string(unit) == "mm") return rmse;
+  return std::nullopt;
+}
 
 FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,
                     const FitOptions& options, const FitProgress& progress) {
@@ -80,9 +93,7 @@ FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std:
   }
   out.joint = fit_least_squares(dataset, out.initial, parameters, options.least_squares,
                                 [&](int iteration, int max_iterations, double rmse) {
-                                  char detail[64];
-                                  std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse);
-                                  if (progress) progress("least squares", iteration, max_iterations, detail);
+                                  if (progress) progress("least squares", iteration, max_iterations, rmse_detail(rmse));
                                 });
   if (options.profile_loose)
     profile_loose_parameters(dataset, parameters, options.least_squares, options.profile, out.joint,

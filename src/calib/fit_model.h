@@ -7,6 +7,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,12 @@ struct FitReport {
 
 // Stage ("levelling", "algorithm 1: spring_k", "least squares"), progress.
 using FitProgress = std::function<void(const std::string& stage, int done, int total, const std::string& detail)>;
+
+// The progress detail of a least-squares iteration, "RMSE 1.234 mm", and the
+// RMSE read back from one (nullopt for any other detail), so a relay of the
+// progress (the server) can report it as a number.
+std::string rmse_detail(double rmse_mm);
+std::optional<double> rmse_of_detail(const std::string& detail);
 
 // Fits the baseline plus `effects` (switched on with their defaults unless
 // `start` has values for them).

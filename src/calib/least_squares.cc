@@ -76,6 +76,8 @@ class ScaledModel {
       try {
         values.col(j).segment(rows_[s], rows_[s + 1] - rows_[s]) =
             session_residuals(dataset_.sessions[s], params_at(point), options_.replay, &traces[s]);
+      } catch (const SettleInterrupted&) {
+        throw;  // the caller stopped the work: not a failed replay
       } catch (const std::exception&) {
         failed[j] = true;
       }
@@ -125,6 +127,8 @@ class ScaledModel {
         [&](int i) {
           try {
             job(i);
+          } catch (const SettleInterrupted&) {
+            throw;  // the caller stopped the work: not a failed replay
           } catch (const std::exception&) {
             ok = false;
           }
@@ -163,7 +167,13 @@ class DatasetCost : public ceres::CostFunction {
     Eigen::VectorXd r;
     Eigen::MatrixXd j;
     const bool want_j = jacobians && jacobians[0];
-    if (!model_.evaluate(u, r, want_j ? &j : nullptr)) return false;
+    // An interruption must not unwind through Ceres: the evaluation fails,
+    // the callback ends the solve, and fit_least_squares throws after it.
+    try {
+      if (!model_.evaluate(u, r, want_j ? &j : nullptr)) return false;
+    } catch (const SettleInterrupted&) {
+      return false;
+    }
     Eigen::Map<Eigen::VectorXd>(residuals, r.size()) = r;
     if (want_j)
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(jacobians[0], j.rows(),
@@ -177,9 +187,10 @@ class DatasetCost : public ceres::CostFunction {
 
 class ProgressCallback : public ceres::IterationCallback {
  public:
-  ProgressCallback(const LeastSquaresProgress& progress, int max_iterations, long n)
-      : progress_(progress), max_(max_iterations), n_(n) {}
+  ProgressCallback(const LeastSquaresProgress& progress, int max_iterations, long n, const ReplayOptions& replay)
+      : progress_(progress), max_(max_iterations), n_(n), replay_(replay) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (is_interrupted(replay_)) return ceres::SOLVER_ABORT;
     if (progress_) progress_(summary.iteration, max_, std::sqrt(2.0 * summary.cost / std::max(n_, 1L)));
     return ceres::SOLVER_CONTINUE;
   }
@@ -188,6 +199,7 @@ class ProgressCallback : public ceres::IterationCallback {
   const LeastSquaresProgress& progress_;
   int max_;
   long n_;
+  const ReplayOptions& replay_;
 };
 
 double parameter_scale(const FitParameter& p, double start) {
@@ -296,10 +308,11 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
     solver_options.max_num_iterations = options.max_iterations;
     solver_options.function_tolerance = options.function_tolerance;
     solver_options.logging_type = ceres::SILENT;
-    ProgressCallback callback(progress, options.max_iterations, out.residual_count);
+    ProgressCallback callback(progress, options.max_iterations, out.residual_count, options.replay);
     solver_options.callbacks.push_back(&callback);
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
+    throw_if_interrupted(options.replay);
     out.iterations = static_cast<int>(summary.iterations.size());
     out.termination = summary.BriefReport();
   }

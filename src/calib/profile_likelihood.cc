@@ -85,6 +85,8 @@ class EndSearch {
     double rise = kInfinity;
     try {
       rise = std::max(cost_(value, side) - search_.min_cost, 0.0);
+    } catch (const SettleInterrupted&) {
+      throw;  // the caller stopped the work: not a failed replay
     } catch (const std::exception&) {
     }
     const double root = std::isfinite(rise) ? std::sqrt(rise / search_.threshold) : kInfinity;
@@ -158,6 +160,8 @@ class ChordRefit {
       Eigen::VectorXd r_next;
       try {
         r_next = replay(next, traces_[w]);
+      } catch (const SettleInterrupted&) {
+        throw;  // the caller stopped the work: not a failed replay
       } catch (const std::exception&) {
         break;  // keep the point reached
       }

@@ -32,6 +32,8 @@ std::vector<PredictedCapture> replay_session(const Session& session, int segment
         if (start && start->cols() == sim.state().x.cols()) sim.apply(step.action, *start);
         else sim.apply(step.action);
         if (trace) (*trace)[i] = sim.state().x;
+      } catch (const SettleInterrupted&) {
+        throw;  // the caller stopped the work: not a failed replay
       } catch (const std::exception& e) {
         throw SessionError(session.name + ": steps[" + std::to_string(step.index) + "] (" + step.action.op_name() +
                            "): " + e.what());

@@ -79,10 +79,17 @@ ReplayOptions fitting_replay(ReplayOptions options) {
   return options;
 }
 
+bool is_interrupted(const ReplayOptions& options) { return options.interrupted && options.interrupted(); }
+
+void throw_if_interrupted(const ReplayOptions& options) {
+  if (is_interrupted(options)) throw SettleInterrupted();
+}
+
 SimulatorOptions simulator_options(const ModelParams& params, const ReplayOptions& options) {
   SimulatorOptions out;
   out.static_options = options.solver;
   out.fallback_max_steps = options.fallback_max_steps;
+  out.interrupted = options.interrupted;
   params.apply_to(out);
   return out;
 }

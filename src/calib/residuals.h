@@ -23,7 +23,17 @@ struct ReplayOptions {
   // parameters where the model has no equilibrium (the net creases just
   // below levelling), and must learn that quickly; see fitting_replay().
   long fallback_max_steps = 2'000'000;
+  // Polled while settling (SimulatorOptions::interrupted): true stops the
+  // replay, the fit or the diagnosis with SettleInterrupted, which the
+  // library's fallbacks for failed replays let through. A server sets it
+  // from its caller's cancellation and deadline.
+  std::function<bool()> interrupted;
 };
+
+// True when options.interrupted is set and says so.
+bool is_interrupted(const ReplayOptions& options);
+// Throws SettleInterrupted when is_interrupted(options).
+void throw_if_interrupted(const ReplayOptions& options);
 
 // The options of fits: a short explicit fallback.
 ReplayOptions fitting_replay(ReplayOptions options);

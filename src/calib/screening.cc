@@ -89,6 +89,8 @@ ScreeningPrediction screen_effect(const Dataset& dataset, const LeastSquaresResu
               session_residuals(dataset.sessions[s], start, options.replay, nullptr, &traces[s]);
         },
         options.replay.threads);
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
   } catch (const std::exception& e) {
     throw std::runtime_error("the model fails to replay the dataset with " + effect + " at its start values: " +
                              e.what());
@@ -121,6 +123,8 @@ ScreeningPrediction screen_effect(const Dataset& dataset, const LeastSquaresResu
           try {
             columns.col(k).segment(rows[s], rows[s + 1] - rows[s]) =
                 session_residuals(dataset.sessions[s], moved, options.replay, &traces[s]);
+          } catch (const SettleInterrupted&) {
+            throw;  // the caller stopped the work: not a failed replay
           } catch (const std::exception&) {
             failed[k] = true;
           }

@@ -59,6 +59,8 @@ BisectionResult fit_stiffness_by_bisection(const Dataset& dataset, const ModelPa
       std::vector<ReplayTrace> traces;
       e = excess_deflection_mm(used, evaluate_dataset(used, params, options.replay, {}, &last_traces, &traces), filter);
       last_traces = std::move(traces);
+    } catch (const SettleInterrupted&) {
+      throw;  // the caller stopped the work: not a failed replay
     } catch (const std::exception&) {
     }
     ++out.evaluations;

@@ -15,9 +15,9 @@ except ImportError as e:  # pragma: no cover - a message a user can act on
         "hapticjam_client needs the generated stubs: build them (cmake --build build --target hj_python_stubs) "
         "and put build/clients/python on PYTHONPATH (" + str(e) + ")") from e
 
-from .client import Client, ClientError, file_goal, map_goal
+from .client import Client, ClientError, dataset_upload, file_goal, map_goal
 from .surface import Surface, write_png
 
-__all__ = ["Client", "ClientError", "Surface", "file_goal", "map_goal", "write_png", "array_pb2",
+__all__ = ["Client", "ClientError", "Surface", "dataset_upload", "file_goal", "map_goal", "write_png", "array_pb2",
            "device_service_pb2", "device_service_pb2_grpc", "goal_pb2", "plan_pb2", "planning_service_pb2",
            "planning_service_pb2_grpc", "surface_pb2"]

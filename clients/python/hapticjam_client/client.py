@@ -1,13 +1,15 @@
 """Client: one channel to a hapticjam-server, the bearer token on every call,
-and the PlanningService and DeviceService calls as methods. A refused call
+and the PlanningService and DeviceService calls (and CalibrationService's
+Compare) as methods. A refused call
 raises ClientError carrying the gRPC status code and the server's message."""
 
 import json
 import os
 
 import grpc
-from hapticjam.v1 import (array_pb2, device_service_pb2, device_service_pb2_grpc, goal_pb2, plan_pb2,
-                          planning_service_pb2, planning_service_pb2_grpc)
+from hapticjam.v1 import (array_pb2, calibration_service_pb2, calibration_service_pb2_grpc, device_service_pb2,
+                          device_service_pb2_grpc, goal_pb2, plan_pb2, planning_service_pb2,
+                          planning_service_pb2_grpc)
 
 # Goals (meshes, DEMs) may exceed gRPC's 4 MiB default; the server takes up to 64 MiB.
 MAX_MESSAGE_BYTES = 64 << 20
@@ -49,6 +51,29 @@ def _finish_goal(goal, region, max_height_mm, up_axis, hue, view_resolution):
         max_height_mm=max_height_mm, up_axis=up_axis, view_resolution=view_resolution,
         encoding=goal_pb2.HEIGHT_ENCODING_HUE if hue else goal_pb2.HEIGHT_ENCODING_UNSPECIFIED))
     return goal
+
+
+def dataset_upload(path):
+    """An UploadedDataset from a dataset folder: each sub-folder holding a
+    session.json, with the frame files its steps name (the server validates)."""
+    dataset = calibration_service_pb2.UploadedDataset(name=os.path.basename(os.path.abspath(path)))
+    for name in sorted(os.listdir(path)):
+        folder = os.path.join(path, name)
+        session_file = os.path.join(folder, "session.json")
+        if not os.path.isfile(session_file):
+            continue
+        with open(session_file) as f:
+            text = f.read()
+        session = dataset.sessions.add(name=name, session_json=text)
+        try:
+            frames = {s["frame"] for s in json.loads(text).get("steps", []) if isinstance(s.get("frame"), str)}
+        except (ValueError, AttributeError):
+            frames = set()  # the server names what is wrong
+        for frame in sorted(frames):
+            if os.path.isfile(os.path.join(folder, frame)):
+                with open(os.path.join(folder, frame), "rb") as f:
+                    session.files.add(path=frame, content=f.read())
+    return dataset
 
 
 def array_spec(rows, cols, segments=0, cell_size_mm=0.0):
@@ -97,6 +122,7 @@ class Client:
         self.metadata = [("authorization", "Bearer " + token)] if token else []
         self.planning = planning_service_pb2_grpc.PlanningServiceStub(self.channel)
         self.device = device_service_pb2_grpc.DeviceServiceStub(self.channel)
+        self.calibration = calibration_service_pb2_grpc.CalibrationServiceStub(self.channel)
 
     def close(self):
         self.channel.close()
@@ -144,6 +170,29 @@ class Client:
         if result is None:
             raise RuntimeError("the server ended the plan stream without a result")
         return result, snapshots
+
+    # -- calibration --
+
+    def compare(self, dataset, params_json="", effects=(), segments=0, on_progress=None, timeout=None):
+        """Compares the model with an UploadedDataset (dataset_upload(path));
+        on_progress(CalibrationProgress) sees every progress event. Returns the
+        CompareResult (summary_json, rmse_mm, mae_mm, samples, noise_floor_mm)."""
+        options = calibration_service_pb2.CalibrationOptions(params_json=params_json, effects=list(effects),
+                                                             segments=segments)
+        request = calibration_service_pb2.CompareRequest(dataset=dataset, options=options)
+        result = None
+        try:
+            for event in self.calibration.Compare(request, timeout=timeout, metadata=self.metadata):
+                if event.WhichOneof("event") == "progress":
+                    if on_progress:
+                        on_progress(event.progress)
+                else:
+                    result = event.result
+        except grpc.RpcError as e:
+            raise ClientError("Compare", e) from None
+        if result is None:
+            raise RuntimeError("the server ended the compare stream without a result")
+        return result
 
     # -- device --
 
