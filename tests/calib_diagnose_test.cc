@@ -29,10 +29,6 @@ DiagnoseOptions quick_options() {
   return o;
 }
 
-double fitted(const ModelParams& p, const std::string& effect, const std::string& name) {
-  return p.effect_parameters.at(effect).at(name);
-}
-
 TEST(Diagnose, FindsTheBendingStiffnessInDemoBending) {
   const Dataset d = cheap("demo-bending");
   const Diagnosis result = diagnose(d, ModelParams{}, quick_options());

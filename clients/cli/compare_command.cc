@@ -54,7 +54,7 @@ int compare(const CalibArgs& args) {
                    number(evaluation.rmse_mm()) + " mm, mean absolute " + number(evaluation.mae_mm()) +
                    " mm. Noise floor of the sensor (a perfect model): " + number(floor) + " mm.");
   std::vector<std::vector<std::string>> rows;
-  Plot pressure_plot{"Error against pressure", "pressure (kPa)", "RMSE (mm)", {}, {}, 0.0, floor, "noise floor"};
+  Plot pressure_plot{"Error against pressure", "pressure (kPa)", "RMSE (mm)", {}, {}, 0.0, floor, "noise floor", {}};
   PlotSeries unjammed{"unjammed", {}, {}, "#1f77b4", false, true}, jammed{"some cells jammed", {}, {}, "#d62728", false, true};
   ProgressLine images("heat maps");
   const int total_images = dataset.capture_count();

@@ -80,7 +80,7 @@ int diagnose_dataset(const CalibArgs& args) {
   html.table({"region", "RMSE mm", "samples", "rest", "RMSE mm", "samples"}, split_rows);
   html.heading("Error ladder");
   Plot plot{"Error as each chosen effect is added", "model", "RMSE (mm)", {}, {}, 0.0, d.noise_floor_mm,
-            "noise floor " + num(d.noise_floor_mm, "%.2f")};
+            "noise floor " + num(d.noise_floor_mm, "%.2f"), {}};
   PlotSeries fitted{"fitted", {}, {}, "#1f77b4"}, heldout{"held out (LOSO)", {}, {}, "#d62728"};
   for (size_t k = 0; k < d.ladder.size(); ++k) {
     plot.x_ticks.push_back(d.ladder[k].label);
