@@ -15,8 +15,19 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::vector<PredictedCapture> predict(const MeasuredSession& session, const ModelParams& params,
                                       const ReplayOptions& options, const ReplayTrace* warm_start = nullptr,
                                       ReplayTrace* trace = nullptr) {
-  return replay_session(session.session, options.segments, params.surface, simulator_options(params, options), {},
-                        warm_start, trace);
+  if (!options.tally)
+    return replay_session(session.session, options.segments, params.surface, simulator_options(params, options), {},
+                          warm_start, trace);
+  const double cpu_start = thread_cpu_seconds();
+  try {
+    auto out = replay_session(session.session, options.segments, params.surface, simulator_options(params, options),
+                              {}, warm_start, trace);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true);
+    return out;
+  } catch (...) {
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, false);
+    throw;
+  }
 }
 
 }  // namespace

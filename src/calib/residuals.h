@@ -12,6 +12,7 @@
 #include "calib/dataset.h"
 #include "calib/model_params.h"
 #include "calib/replay.h"
+#include "calib/replay_tally.h"
 
 namespace hj {
 
@@ -23,6 +24,8 @@ struct ReplayOptions {
   // parameters where the model has no equilibrium (the net creases just
   // below levelling), and must learn that quickly; see fitting_replay().
   long fallback_max_steps = 2'000'000;
+  // If set, every session replay is counted there (not owned; thread-safe).
+  ReplayTally* tally = nullptr;
 };
 
 // The options of fits: a short explicit fallback.
