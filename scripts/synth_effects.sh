@@ -84,11 +84,23 @@ for s in "${chosen[@]}"; do
   ln -s "$source_dataset/$s" "$base/$s"
 done
 
-wanted() { [[ -z "$only" || ",$only," == *",$1,"* ]]; }
+# The cases in the order --cases gives them (cheapest first, say), else all.
+ordered=()
+if [[ -n "$only" ]]; then
+  IFS=, read -ra requested <<<"$only"
+  for want in "${requested[@]}"; do
+    found=0
+    for entry in "${cases[@]}"; do
+      [[ "${entry%%|*}" == "$want" ]] && { ordered+=("$entry"); found=1; }
+    done
+    [[ $found == 1 ]] || { echo "synth_effects.sh: unknown case $want" >&2; exit 2; }
+  done
+else
+  ordered=("${cases[@]}")
+fi
 
-for entry in "${cases[@]}"; do
+for entry in "${ordered[@]}"; do
   IFS='|' read -r name effects sets <<<"$entry"
-  wanted "$name" || continue
   dir="$work/$name"
   mkdir -p "$dir"
   model=(--params "$truth_base")
@@ -116,10 +128,7 @@ for entry in "${cases[@]}"; do
 done
 
 names=()
-for entry in "${cases[@]}"; do
-  IFS='|' read -r name _ <<<"$entry"
-  wanted "$name" && names+=("$name")
-done
+for entry in "${ordered[@]}"; do names+=("${entry%%|*}"); done
 if [[ -n "$table" ]]; then
   python3 "$repo/scripts/synth_effects_table.py" "$work" "$sessions" "${names[@]}" >"$table"
 else

@@ -118,5 +118,33 @@ TEST(CalibDiagnoseSynth, ChoosesNothingWithoutAnEffect) {
   EXPECT_LT(result.baseline.joint.rmse_mm, 1.05 * result.noise_floor_mm);
 }
 
+// The loophole the control dataset found: a sample the predicted surface
+// does not cover (here, outside the array) is predicted at the clamp level,
+// 0 mm, so its residual is -measured, not 0 (a perfect fit).
+TEST(CalibDiagnoseSynth, UncoveredSamplesArePredictedAtTheClampLevel) {
+  MeasuredSession m;
+  m.session.name = "edge";
+  m.session.device = {3, 4, 38.0, 3.45};
+  m.session.grid = {5, 1, -20.0, 57.0, 10.0, 2.0};  // x = -20, -10, 0, 10, 20 mm
+  SessionStep capture;
+  capture.kind = SessionStep::Kind::kCapture;
+  capture.frame = "frames/000.csv";
+  m.session.steps = {capture};
+  MeasuredCapture c;
+  c.frame = capture.frame;
+  c.heights_mm = Eigen::MatrixXd::Constant(1, 5, 3.0);
+  c.heights_mm(0, 4) = NAN;  // missing: not a residual at all
+  c.jammed.assign(12, false);
+  m.captures = {c};
+  ModelParams params = true_baseline();
+  const Eigen::VectorXd r = session_residuals(m, params, fitting_replay({}));
+  ASSERT_EQ(r.size(), 4);
+  EXPECT_EQ(r[0], -3.0);  // outside the array
+  EXPECT_EQ(r[1], -3.0);
+  // On the clamped edge and inside, the surface is predicted (it sags at rest).
+  EXPECT_NEAR(r[2], -3.0, 1e-9);
+  EXPECT_LT(r[3], -3.0);
+}
+
 }  // namespace
 }  // namespace hj

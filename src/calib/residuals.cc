@@ -163,7 +163,8 @@ Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelPar
       for (int ix = 0; ix < measured.cols(); ++ix) {
         if (std::isnan(measured(iy, ix))) continue;
         const double p = predicted[c].heights_mm(iy, ix);
-        out[k++] = std::isnan(p) ? 0.0 : p - measured(iy, ix);
+        // Not covered: the rig's clamp level, 0 mm (see residuals.h).
+        out[k++] = std::isnan(p) ? -measured(iy, ix) : p - measured(iy, ix);
       }
   }
   return out;
