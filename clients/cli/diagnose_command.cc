@@ -28,6 +28,36 @@ constexpr const char* kDiagnoseUsage =
     "  --no-screening  refit every candidate (default: only those whose predicted gain, from one\n"
     "                  Gauss-Newton step at the current optimum, could pass; see README)\n";
 
+// The stages grouped as the speed report asks: the baseline fit (levelling,
+// Algorithm 1, least squares), screening, candidate refits, cross-validation
+// (baseline and candidates), the residual pattern.
+nlohmann::json time_split(const nlohmann::json& timing) {
+  auto part_of = [](const std::string& stage) -> std::string {
+    if (stage.rfind("screening ", 0) == 0) return "screening";
+    if (stage.rfind("candidate ", 0) == 0) return "refits";
+    if (stage == "cross-validation" || stage == "residual pattern") return stage;
+    return "baseline fit";
+  };
+  nlohmann::json out = nlohmann::json::object();
+  for (const char* part : {"baseline fit", "cross-validation", "residual pattern", "screening", "refits"})
+    out[part] = {{"wall_s", 0.0}, {"cpu_s", 0.0}, {"replays", 0L}};
+  for (const auto& t : timing) {
+    nlohmann::json& part = out[part_of(t["stage"].get<std::string>())];
+    part["wall_s"] = part["wall_s"].get<double>() + t["wall_s"].get<double>();
+    part["cpu_s"] = part["cpu_s"].get<double>() + t["cpu_s"].get<double>();
+    part["replays"] = part["replays"].get<long>() + t.value("replays", 0L);
+  }
+  return out;
+}
+
+nlohmann::json replays_json(const ReplayTally& tally) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : tally.entries())
+    out.push_back({{"session", e.session}, {"replays", e.replays}, {"failed", e.failed}, {"cpu_s", e.cpu_s},
+                   {"cpu_s_per_replay", e.replays ? e.cpu_s / e.replays : 0.0}});
+  return out;
+}
+
 std::string num(double v, const char* format = "%.3f") {
   char b[32];
   std::snprintf(b, sizeof b, format, v);
@@ -46,8 +76,10 @@ int diagnose_dataset(const CalibArgs& args) {
   options.screening = args.screening;
   options.fit.least_squares.max_iterations = args.max_iterations;
   options.fit.least_squares.replay = fitting_replay(replay_options(args));
+  ReplayTally tally;
+  options.fit.least_squares.replay.tally = &tally;
   options.fit.bisection.replay = options.fit.least_squares.replay;
-  StageProgress progress;
+  StageProgress progress(&tally);
   const Diagnosis d = diagnose(dataset, start_model, options, std::ref(progress));
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -55,7 +87,11 @@ int diagnose_dataset(const CalibArgs& args) {
 
   const LeastSquaresResult& base = d.baseline.joint;
   nlohmann::json doc = diagnosis_json(d);
-  doc.update({{"seconds", seconds}, {"cpu_seconds", cpu_seconds}, {"timing", progress.timing()}});
+  doc.update({{"seconds", seconds},
+              {"cpu_seconds", cpu_seconds},
+              {"timing", progress.timing()},
+              {"time_split", time_split(progress.timing())},
+              {"replays", replays_json(tally)}});
   const std::filesystem::path out(args.out);
   write_json(out / "diagnosis.json", doc);
   write_model_params(out / "params.json", d.final_params, {{"verdict", d.verdict}});
@@ -126,8 +162,15 @@ int diagnose_dataset(const CalibArgs& args) {
                 c.significant ? "significant" : c.screened_out ? ("screened out: " + c.screening_note).c_str() : "");
   for (const auto& f : d.pattern.findings) std::printf("%s\n", f.c_str());
   for (const auto& t : progress.timing())
-    std::printf("  time in %-40s %7.1f s wall %7.1f s CPU\n", t["stage"].get<std::string>().c_str(),
-                t["wall_s"].get<double>(), t["cpu_s"].get<double>());
+    std::printf("  time in %-40s %7.1f s wall %7.1f s CPU %5ld replays\n", t["stage"].get<std::string>().c_str(),
+                t["wall_s"].get<double>(), t["cpu_s"].get<double>(), t["replays"].get<long>());
+  for (const auto& [part, t] : doc["time_split"].items())
+    std::printf("  %-20s %7.1f s wall %7.1f s CPU %5ld replays\n", part.c_str(), t["wall_s"].get<double>(),
+                t["cpu_s"].get<double>(), t["replays"].get<long>());
+  for (const auto& e : tally.entries())
+    std::printf("  replays of %-20s %5ld x %6.3f s CPU = %7.1f s%s\n", e.session.c_str(), e.replays,
+                e.replays ? e.cpu_s / e.replays : 0.0, e.cpu_s,
+                e.failed ? (" (" + std::to_string(e.failed) + " failed)").c_str() : "");
   std::printf("%s\nwrote %s in %.1f s (CPU %.1f s)\n", verdict_text.c_str(), (out / "diagnosis.json").c_str(), seconds,
               cpu_seconds);
   return 0;

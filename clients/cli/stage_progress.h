@@ -1,6 +1,7 @@
 // Progress of a job with stages (levelling, Algorithm 1, least squares ...):
 // one ProgressLine per stage, replaced when the stage changes, and the wall
-// and CPU time (all threads) spent in each stage, for the speed report.
+// and CPU time (all threads) spent in each stage, for the speed report; with
+// a ReplayTally, also the session replays each stage made.
 #pragma once
 
 #include <chrono>
@@ -11,12 +12,17 @@
 #include <string>
 #include <vector>
 
+#include "calib/replay_tally.h"
 #include "progress.h"
 
 namespace hj::cli {
 
 class StageProgress {
  public:
+  StageProgress() = default;
+  // Counts the replays of `tally` (which must outlive this) per stage.
+  explicit StageProgress(const ReplayTally* tally) : tally_(tally), replays_since_(tally ? tally->replays() : 0) {}
+
   void operator()(const std::string& stage, int done, int total, const std::string& detail) {
     if (!line_ || stage != stage_) {
       if (line_) line_->finish();
@@ -32,11 +38,14 @@ class StageProgress {
     line_.reset();
   }
 
-  // {"stage": {"wall_s", "cpu_s"}} in order of first appearance.
+  // [{"stage", "wall_s", "cpu_s"(, "replays")}] in order of first appearance.
   nlohmann::json timing() const {
     nlohmann::json out = nlohmann::json::array();
-    for (const auto& name : order_)
-      out.push_back({{"stage", name}, {"wall_s", time_.at(name).first}, {"cpu_s", time_.at(name).second}});
+    for (const auto& name : order_) {
+      nlohmann::json entry = {{"stage", name}, {"wall_s", time_.at(name).first}, {"cpu_s", time_.at(name).second}};
+      if (tally_) entry["replays"] = replays_.count(name) ? replays_.at(name) : 0L;
+      out.push_back(entry);
+    }
     return out;
   }
 
@@ -53,6 +62,11 @@ class StageProgress {
     }
     since_ = now;
     cpu_since_ = cpu;
+    if (tally_) {
+      const long replays = tally_->replays();
+      if (line_) replays_[stage_] += replays - replays_since_;
+      replays_since_ = replays;
+    }
   }
 
   std::string stage_;
@@ -61,6 +75,9 @@ class StageProgress {
   std::clock_t cpu_since_ = std::clock();
   std::vector<std::string> order_;
   std::map<std::string, std::pair<double, double>> time_;
+  const ReplayTally* tally_ = nullptr;
+  long replays_since_ = 0;
+  std::map<std::string, long> replays_;
 };
 
 }  // namespace hj::cli

@@ -30,6 +30,10 @@ struct DiagnoseOptions {
   // others keep their predicted figures. false: refit every candidate.
   bool screening = true;
   double screen_margin = 0.5;
+  // A candidate whose predicted delta BIC passes but whose predicted
+  // held-out gain does not is screened out only if replaying the held-out
+  // sessions at the folds' predicted parameters (one replay of the
+  // dataset) confirms it (heldout_replayed below).
 };
 
 struct CandidateFit {
@@ -45,6 +49,7 @@ struct CandidateFit {
   std::string screening_note;
   bool screened = false;  // the screening's predictions below exist
   double predicted_rmse_mm = 0.0, predicted_heldout_rmse_mm = 0.0, predicted_delta_bic = 0.0;
+  bool heldout_replayed = false;  // predicted_heldout_rmse_mm is from replayed held-out sessions
 };
 
 struct LadderStep {

@@ -44,9 +44,15 @@ class ScaledModel {
   // Every replay starts each settle from the cached point's settled states;
   // the difference columns from those of u itself.
   bool evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& r, Eigen::MatrixXd* jacobian) {
-    if (jacobian && have_cache_ && u == cache_u_) {
+    if (have_cache_ && u == cache_u_) {
       r = cache_r_;
-      *jacobian = cache_j_;
+      if (jacobian) *jacobian = cache_j_;
+      return true;
+    }
+    // Ceres evaluates the line search's point, then the same point again
+    // as its candidate: the residuals of the last point are kept too.
+    if (!jacobian && have_last_ && u == last_u_) {
+      r = last_r_;
       return true;
     }
     const int p = parameter_count(), sessions = static_cast<int>(dataset_.sessions.size());
@@ -58,6 +64,9 @@ class ScaledModel {
               dataset_.sessions[s], params_at(u), options_.replay, hint(s), &traces[s]);
         }))
       return false;
+    have_last_ = true;
+    last_u_ = u;
+    last_r_ = r;
     if (!jacobian) return true;
     Eigen::MatrixXd values(residual_count_all(), p);
     std::vector<double> steps(p);
@@ -149,6 +158,8 @@ class ScaledModel {
   std::vector<int> rows_;
   bool have_cache_ = false;
   Eigen::VectorXd cache_u_, cache_r_;
+  bool have_last_ = false;
+  Eigen::VectorXd last_u_, last_r_;  // the last point evaluated, residuals only
   Eigen::MatrixXd cache_j_;
   std::vector<ReplayTrace> cache_traces_;  // per session, at cache_u_
   int jacobians_ = 0;
@@ -307,6 +318,14 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
     solver_options.linear_solver_type = ceres::DENSE_QR;
     solver_options.max_num_iterations = options.max_iterations;
     solver_options.function_tolerance = options.function_tolerance;
+    // With bounds, every iteration of Ceres' trust region runs a projected
+    // Armijo line search along its step. Its default cubic interpolation
+    // asks for the gradient at every trial point, i.e. a whole Jacobian
+    // (1 + p replays of the dataset) per trial, and near a bifurcation
+    // (kappa_jam's second equilibrium) it contracts many times: most of a
+    // fit's time went there. Quadratic interpolation needs the cost only
+    // (one replay per trial).
+    solver_options.line_search_interpolation_type = ceres::QUADRATIC;
     solver_options.logging_type = ceres::SILENT;
     ProgressCallback callback(progress, options.max_iterations, out.residual_count, options.replay);
     solver_options.callbacks.push_back(&callback);

@@ -15,8 +15,19 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::vector<PredictedCapture> predict(const MeasuredSession& session, const ModelParams& params,
                                       const ReplayOptions& options, const ReplayTrace* warm_start = nullptr,
                                       ReplayTrace* trace = nullptr) {
-  return replay_session(session.session, options.segments, params.surface, simulator_options(params, options), {},
-                        warm_start, trace);
+  if (!options.tally)
+    return replay_session(session.session, options.segments, params.surface, simulator_options(params, options), {},
+                          warm_start, trace);
+  const double cpu_start = thread_cpu_seconds();
+  try {
+    auto out = replay_session(session.session, options.segments, params.surface, simulator_options(params, options),
+                              {}, warm_start, trace);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true);
+    return out;
+  } catch (...) {
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, false);
+    throw;
+  }
 }
 
 }  // namespace
@@ -159,7 +170,8 @@ Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelPar
       for (int ix = 0; ix < measured.cols(); ++ix) {
         if (std::isnan(measured(iy, ix))) continue;
         const double p = predicted[c].heights_mm(iy, ix);
-        out[k++] = std::isnan(p) ? 0.0 : p - measured(iy, ix);
+        // Not covered: the rig's clamp level, 0 mm (see residuals.h).
+        out[k++] = std::isnan(p) ? -measured(iy, ix) : p - measured(iy, ix);
       }
   }
   return out;

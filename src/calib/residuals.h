@@ -12,6 +12,7 @@
 #include "calib/dataset.h"
 #include "calib/model_params.h"
 #include "calib/replay.h"
+#include "calib/replay_tally.h"
 
 namespace hj {
 
@@ -28,6 +29,8 @@ struct ReplayOptions {
   // library's fallbacks for failed replays let through. A server sets it
   // from its caller's cancellation and deadline.
   std::function<bool()> interrupted;
+  // If set, every session replay is counted there (not owned; thread-safe).
+  ReplayTally* tally = nullptr;
 };
 
 // True when options.interrupted is set and says so.
@@ -95,9 +98,13 @@ Evaluation evaluate_dataset(const Dataset& dataset, const ModelParams& params, c
                             std::vector<ReplayTrace>* traces = nullptr);
 
 // The least-squares residuals of one session: predicted - measured in mm at
-// every sample the camera saw, capture by capture, row by row; 0 where the
-// prediction does not cover the sample, so that the layout depends on the
-// measurement only (residual_count entries).
+// every sample the camera saw, capture by capture, row by row
+// (residual_count entries, so that the layout depends on the measurement
+// only). Where the predicted surface does not cover a sample, it is
+// predicted at the clamp level, 0 mm (the rig's frame around the
+// membrane), not counted as a perfect fit: otherwise a model that pulls
+// its rim in a little (boundary_compliance) uncovers the rim samples and
+// lowers its cost by their noise, and diagnose chose it on data without it.
 // warm_start / trace: as replay_session's (replay.h).
 Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelParams& params,
                                   const ReplayOptions& options, const ReplayTrace* warm_start = nullptr,

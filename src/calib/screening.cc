@@ -195,6 +195,15 @@ ScreeningPrediction screen_effect(const Dataset& dataset, const LeastSquaresResu
   out.rmse_mm = std::sqrt(out.sum_sq_mm2 / std::max(n, 1L));
   out.heldout_rmse_mm = linear_heldout_rmse(j, r1, rows);
   out.reference_heldout_rmse_mm = linear_heldout_rmse(current.jacobian, current.residuals, rows);
+  out.residuals = r1;
+  out.scale.resize(p);
+  out.active = current.active;
+  for (int k = 0; k < p_base; ++k) out.scale[k] = current.scale[k];
+  for (size_t k = 0; k < kept.size(); ++k) {
+    out.scale[p_base + k] = scale[kept[k]];
+    out.active.push_back(own[kept[k]]);
+  }
+  out.jacobian = std::move(j);
   return out;
 }
 

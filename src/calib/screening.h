@@ -28,6 +28,14 @@ struct ScreeningPrediction {
   // that the linearisation's own error cancels.
   double reference_heldout_rmse_mm = 0.0;
   int replays = 0;               // whole-dataset replays it cost
+  // The linearisation itself, laid out as LeastSquaresResult's optimum
+  // fields (residuals after the step, Jacobian, scale, active indices into
+  // `parameters`), so that cross_validate() can check the held-out
+  // prediction by replaying the held-out sessions.
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd scale;
+  std::vector<int> active;
 };
 
 // @param current     fit_least_squares of the current model (its residuals,

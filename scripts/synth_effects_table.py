@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""The table of scripts/synth_effects.sh: one row per synthetic dataset, from
+WORK/CASE/data/truth.json (the true model), WORK/CASE/compare/summary.json
+(the data against the baseline model) and WORK/CASE/diagnose/diagnosis.json.
+
+usage: synth_effects_table.py WORK SESSIONS CASE [CASE ...]
+"""
+import json
+import math
+import os
+import sys
+
+
+def load(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def g(v):
+    return "%.4g" % v
+
+
+def true_values(truth):
+    out = []
+    for effect, params in sorted(truth.get("effects", {}).items()):
+        for name, value in sorted(params.items()):
+            out.append((effect, name, value))
+    return out
+
+
+def fitted_value(diag, effect, name):
+    """The parameter as the chosen model fitted it, else as the candidate's
+    refit (or, if screened out, its prediction) on the baseline had it."""
+    final = diag.get("final_params", {}).get("effects", {})
+    if effect in final and name in final[effect]:
+        return final[effect][name], ""
+    for c in diag.get("ranking", []):
+        if c["effect"] == effect:
+            v = c["params"].get("effects", {}).get(effect, {}).get(name)
+            if v is not None:
+                return v, " (predicted, not chosen)" if c.get("screened_out") else " (not chosen)"
+    return None, ""
+
+
+def row(work, case):
+    base = os.path.join(work, case)
+    truth = load(os.path.join(base, "data", "truth.json"))
+    summary = load(os.path.join(base, "compare", "summary.json"))
+    diag = load(os.path.join(base, "diagnose", "diagnosis.json"))
+    if truth is None:
+        return None
+    truths = true_values(truth)
+    effects = ", ".join(sorted(truth.get("effects", {}))) or "none"
+    true_text = "<br>".join("%s.%s = %s" % (e, n, g(v)) for e, n, v in truths) or "-"
+    rmse = summary["rmse_mm"] if summary else float("nan")
+    floor = summary.get("noise_floor_mm", 1.04) if summary else 1.04
+    signal = math.sqrt(max(rmse * rmse - floor * floor, 0.0)) if summary else float("nan")
+    if diag is None:
+        return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal), "not run", "", "", "", "", ""]
+    verdict = ", ".join(diag["verdict"]) or "none"
+    correct = sorted(diag["verdict"]) == sorted(truth.get("effects", {}))
+    ranking = []
+    for c in diag["ranking"][:3]:
+        mark = "*" if c["significant"] else ("s" if c.get("screened_out") else "")
+        ranking.append("%s %.0f%s" % (c["effect"], c["delta_bic"], mark))
+    for c in diag.get("later_rounds", []):
+        if c["significant"]:
+            ranking.append("then %s %.0f*" % (c["effect"], c["delta_bic"]))
+    fitted = []
+    for e, n, v in truths:
+        f, note = fitted_value(diag, e, n)
+        fitted.append("%s.%s = %s%s" % (e, n, g(f), note) if f is not None else "%s.%s: -" % (e, n))
+    surface = diag["final_params"]["surface"]
+    surface_text = "m %.3f, k %.1f, kj %.2f" % (surface["mass_kg"], surface["spring_k"], surface["kappa_jam"])
+    ladder = diag["ladder"]
+    rmse_text = "%.3f -> %.3f" % (ladder[0]["rmse_mm"], ladder[-1]["rmse_mm"])
+    return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal),
+            ("**%s**" if correct else "%s (WRONG)") % verdict, "<br>".join(ranking), "<br>".join(fitted) or "-",
+            surface_text, rmse_text, "%.0f" % diag["cpu_seconds"]]
+
+
+def main():
+    if len(sys.argv) < 4:
+        sys.exit(__doc__)
+    work, sessions, cases = sys.argv[1], sys.argv[2], sys.argv[3:]
+    head = ["dataset", "true effects", "true parameters", "RMSE vs baseline mm (effect alone)", "verdict",
+            "ranking top 3: delta BIC (* significant, s screened out)", "fitted vs true", "final m kg, k N/m, kappa_jam",
+            "RMSE mm baseline -> final", "CPU s"]
+    print("Sessions of demo-baseline replayed: %s." % sessions.replace(",", ", "))
+    print()
+    print("| " + " | ".join(head) + " |")
+    print("|" + "---|" * len(head))
+    for case in cases:
+        r = row(work, case)
+        if r:
+            print("| " + " | ".join(r) + " |")
+
+
+if __name__ == "__main__":
+    main()

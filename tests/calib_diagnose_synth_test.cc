@@ -1,0 +1,150 @@
+// The diagnosis is not a special case for the shared datasets: on a tiny
+// dataset synthesised here (3 x 4 array, two short sessions, the simulated
+// camera's 1 mm noise) with the camera tilted and offset (sensor_tilt), the
+// same code that finds bending in demo-bending chooses sensor_tilt among
+// three candidates and fits its tilt and offset; on the same sessions
+// without the effect it chooses nothing. scripts/synth_effects.sh runs the
+// whole matrix (every effect, combinations) on demo-baseline's sessions.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "calib/diagnosis.h"
+#include "calib/synthesize.h"
+#include "scratch_dir.h"
+
+namespace hj {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+json session_json(const std::string& name, const json& steps) {
+  return {{"format", "hapticjam.session/1"},
+          {"name", name},
+          {"device", {{"rows", 3}, {"cols", 4}, {"cell_size_mm", 38.0}, {"max_pressure_kpa", 3.45}}},
+          {"sensor", {{"kind", "depth camera"}, {"resolution_mm", 1.0}, {"accuracy_mm", 1.0}}},
+          {"grid", {{"nx", 77}, {"ny", 58}, {"x0_mm", 0.0}, {"y0_mm", 0.0}, {"dx_mm", 2.0}, {"dy_mm", 2.0}}},
+          {"steps", steps}};
+}
+
+json capture(int k) { return {{"op", "capture"}, {"frame", "frames/00" + std::to_string(k) + ".csv"}}; }
+json pressure(double kpa) { return {{"op", "set_pressure"}, {"kpa", kpa}}; }
+
+// Two short sessions: an unjammed sweep through the levelling pressure
+// (about 0.29 kPa) to 2 kPa, and two jammed cells raised to 1.5 kPa.
+void write_sessions(const fs::path& dir) {
+  const std::pair<std::string, json> sessions[] = {
+      {"sweep", json::array({capture(0), pressure(0.2), capture(1), pressure(0.4), capture(2), pressure(1.0),
+                             capture(3), pressure(2.0), capture(4)})},
+      {"jammed", json::array({capture(0), pressure(0.6), {{"op", "jam"}, {"cell", {1, 1}}},
+                              {{"op", "jam"}, {"cell", {0, 2}}}, capture(1), pressure(1.5), capture(2)})},
+  };
+  for (const auto& [name, steps] : sessions) {
+    fs::create_directories(dir / name);
+    std::ofstream(dir / name / "session.json") << session_json(name, steps).dump(1);
+  }
+}
+
+// demo-baseline's true baseline (its README), not the paper's defaults.
+ModelParams true_baseline() {
+  ModelParams m;
+  m.surface.mass_kg = 0.52;
+  m.surface.spring_k = 58.0;
+  m.surface.kappa_jam = 4.2;
+  return m;
+}
+
+constexpr double kTiltX = 15.0, kTiltY = -10.0, kOffset = 1.5;  // mrad, mrad, mm
+
+Dataset synthetic(const fs::path& root, bool tilted) {
+  write_sessions(root / "sessions");
+  ModelParams truth = true_baseline();
+  if (tilted) {
+    truth.effects = {"sensor_tilt"};
+    truth.effect_parameters["sensor_tilt"] = {{"tilt_x_mrad", kTiltX}, {"tilt_y_mrad", kTiltY}, {"offset_mm", kOffset}};
+  }
+  synthesize_dataset(root / "sessions", root / "data", truth, SynthOptions{});
+  return read_dataset(root / "data");
+}
+
+DiagnoseOptions three_candidates() {
+  DiagnoseOptions o;
+  o.candidates = {"sensor_tilt", "pressure_offset", "jam_contraction"};
+  o.max_effects = 2;
+  o.fit.least_squares.max_iterations = 10;
+  return o;
+}
+
+TEST(CalibDiagnoseSynth, FindsTheCameraTiltAndFitsIt) {
+  testing_support::ScratchDir scratch("tilt");
+  const Dataset d = synthetic(scratch.path, true);
+  const Diagnosis result = diagnose(d, ModelParams{}, three_candidates());
+  ASSERT_TRUE(result.skipped.empty()) << ::testing::PrintToString(result.skipped);
+  ASSERT_FALSE(result.ranking.empty());
+  EXPECT_EQ(result.ranking[0].added, "sensor_tilt");
+  ASSERT_EQ(result.verdict, std::vector<std::string>{"sensor_tilt"});
+  // Each within three of the fit's own standard errors, and those small:
+  // about 0.2-0.4 mrad for the tilts and 0.3 mm for the offset, which
+  // trades off against the mass (both lift the sagging rest state).
+  const LeastSquaresResult& fit = result.ranking[0].fit;
+  const std::pair<const char*, double> truth[] = {
+      {"sensor_tilt.tilt_x_mrad", kTiltX}, {"sensor_tilt.tilt_y_mrad", kTiltY}, {"sensor_tilt.offset_mm", kOffset}};
+  for (const auto& [name, value] : truth) {
+    const ParameterEstimate* e = nullptr;
+    for (const auto& estimate : fit.estimates)
+      if (estimate.parameter.qualified_name() == name) e = &estimate;
+    ASSERT_NE(e, nullptr) << name;
+    EXPECT_LT(e->std_error, 0.5) << name;
+    EXPECT_NEAR(e->value, value, 3.0 * e->std_error) << name;
+    EXPECT_EQ(result.final_params.effect_parameters.at("sensor_tilt").at(name + std::string("sensor_tilt.").size()),
+              e->value);
+  }
+  // With the effect the fit is down at the camera's noise floor.
+  EXPECT_GT(result.baseline.joint.rmse_mm, 1.3 * result.noise_floor_mm);
+  EXPECT_LT(result.ladder.back().rmse_mm, 1.05 * result.noise_floor_mm);
+}
+
+TEST(CalibDiagnoseSynth, ChoosesNothingWithoutAnEffect) {
+  testing_support::ScratchDir scratch("control");
+  const Dataset d = synthetic(scratch.path, false);
+  const Diagnosis result = diagnose(d, ModelParams{}, three_candidates());
+  EXPECT_TRUE(result.skipped.empty()) << ::testing::PrintToString(result.skipped);
+  EXPECT_EQ(result.ranking.size(), 3u);
+  EXPECT_TRUE(result.verdict.empty()) << ::testing::PrintToString(result.verdict);
+  for (const auto& c : result.ranking) EXPECT_FALSE(c.significant) << c.added;
+  EXPECT_LT(result.baseline.joint.rmse_mm, 1.05 * result.noise_floor_mm);
+}
+
+// The loophole the control dataset found: a sample the predicted surface
+// does not cover (here, outside the array) is predicted at the clamp level,
+// 0 mm, so its residual is -measured, not 0 (a perfect fit).
+TEST(CalibDiagnoseSynth, UncoveredSamplesArePredictedAtTheClampLevel) {
+  MeasuredSession m;
+  m.session.name = "edge";
+  m.session.device = {3, 4, 38.0, 3.45};
+  m.session.grid = {5, 1, -20.0, 57.0, 10.0, 2.0};  // x = -20, -10, 0, 10, 20 mm
+  SessionStep capture;
+  capture.kind = SessionStep::Kind::kCapture;
+  capture.frame = "frames/000.csv";
+  m.session.steps = {capture};
+  MeasuredCapture c;
+  c.frame = capture.frame;
+  c.heights_mm = Eigen::MatrixXd::Constant(1, 5, 3.0);
+  c.heights_mm(0, 4) = NAN;  // missing: not a residual at all
+  c.jammed.assign(12, false);
+  m.captures = {c};
+  ModelParams params = true_baseline();
+  const Eigen::VectorXd r = session_residuals(m, params, fitting_replay({}));
+  ASSERT_EQ(r.size(), 4);
+  EXPECT_EQ(r[0], -3.0);  // outside the array
+  EXPECT_EQ(r[1], -3.0);
+  // On the clamped edge and inside, the surface is predicted (it sags at rest).
+  EXPECT_NEAR(r[2], -3.0, 1e-9);
+  EXPECT_LT(r[3], -3.0);
+}
+
+}  // namespace
+}  // namespace hj
