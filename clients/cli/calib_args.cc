@@ -21,10 +21,12 @@ std::vector<std::string> split_list(const std::string& flag, const std::string& 
   }
 }
 
-CalibArgs parse_calib_args(const std::vector<std::string>& args, const std::set<std::string>& allowed) {
+CalibArgs parse_calib_args(const std::vector<std::string>& args, const std::set<std::string>& allowed,
+                           const std::function<bool(ArgCursor&)>& extra, bool known_effects_only) {
   CalibArgs out;
   std::set<std::string> seen;
   for (ArgCursor cursor(args); cursor.next();) {
+    if (extra && extra(cursor)) continue;
     const std::string& a = cursor.arg();
     if (!a.empty() && a[0] == '-') {
       if (!allowed.count(a) && a != "--out") throw std::invalid_argument("unknown option " + a);
@@ -48,7 +50,8 @@ CalibArgs parse_calib_args(const std::vector<std::string>& args, const std::set<
   }
   if (out.dataset.empty()) throw std::invalid_argument("missing DATASET (a folder of session folders)");
   if (out.out.empty()) throw std::invalid_argument("missing --out DIR");
-  for (const auto& e : out.effects) EffectRegistry::instance().get(e);  // names the known effects if unknown
+  if (known_effects_only)
+    for (const auto& e : out.effects) EffectRegistry::instance().get(e);  // names the known effects if unknown
   return out;
 }
 

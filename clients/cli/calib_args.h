@@ -3,11 +3,13 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "args.h"
 #include "calib/dataset.h"
 #include "calib/model_params.h"
 #include "calib/residuals.h"
@@ -31,7 +33,12 @@ struct CalibArgs {
 
 // Parses DATASET and the options in `allowed` (e.g. "--params");
 // std::invalid_argument naming an unknown, repeated or malformed option.
-CalibArgs parse_calib_args(const std::vector<std::string>& args, const std::set<std::string>& allowed);
+// `extra`, if given, is offered each argument first and returns true for
+// one it took (e.g. the remote commands' --server). With
+// known_effects_only, an effect this build does not have is an error (a
+// server may have more: the remote commands leave that to it).
+CalibArgs parse_calib_args(const std::vector<std::string>& args, const std::set<std::string>& allowed,
+                           const std::function<bool(ArgCursor&)>& extra = {}, bool known_effects_only = true);
 
 // "a,b" -> {"a", "b"}; std::invalid_argument naming the flag on an empty item.
 std::vector<std::string> split_list(const std::string& flag, const std::string& text);

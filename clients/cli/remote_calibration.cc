@@ -43,10 +43,7 @@ constexpr const char* kCalibUsage =
 struct RemoteCalibArgs {
   RemoteOptions remote;
   std::string command;  // compare, fit, diagnose
-  std::string dataset, out, params_file;
-  std::vector<std::string> effects, holdout, profile;
-  int segments = 0, threads = 0, max_iterations = 0;  // 0: the server's (the commands') defaults
-  bool no_initial = false, no_screening = false;
+  CalibArgs calib;      // the local command's options, sent with the request
 };
 
 // The options each command takes, beside the remote ones and --out.
@@ -62,29 +59,9 @@ const std::set<std::string>& allowed_options(const std::string& command) {
 RemoteCalibArgs parse_calib(const std::string& command, const std::vector<std::string>& args) {
   RemoteCalibArgs out;
   out.command = command;
-  std::set<std::string> seen;
-  for (ArgCursor c(args); c.next();) {
-    if (take_remote_flag(c, out.remote)) continue;
-    const std::string& a = c.arg();
-    if (!a.empty() && a[0] == '-') {
-      if (a != "--out" && !allowed_options(command).count(a)) throw std::invalid_argument("unknown option " + a);
-      if (!seen.insert(a).second) throw std::invalid_argument(a + " given twice");
-    }
-    if (a == "--out") out.out = c.value();
-    else if (a == "--params") out.params_file = c.value();
-    else if (a == "--effects") out.effects = split_list(a, c.value());
-    else if (a == "--holdout") out.holdout = split_list(a, c.value());
-    else if (a == "--profile") out.profile = split_list(a, c.value());
-    else if (a == "--segments") out.segments = parse_int(a, c.value(), 2, 64);
-    else if (a == "--threads") out.threads = parse_int(a, c.value(), 0, 256);
-    else if (a == "--max-iterations") out.max_iterations = parse_int(a, c.value(), 1, 1000);
-    else if (a == "--no-initial") out.no_initial = true;
-    else if (a == "--no-screening") out.no_screening = true;
-    else if (out.dataset.empty()) out.dataset = a;
-    else throw std::invalid_argument("unexpected argument \"" + a + "\"");
-  }
-  if (out.dataset.empty()) throw std::invalid_argument("missing DATASET (a folder of session folders)");
-  if (out.out.empty()) throw std::invalid_argument("missing --out DIR");
+  out.calib = parse_calib_args(
+      args, allowed_options(command), [&](ArgCursor& c) { return take_remote_flag(c, out.remote); },
+      /*known_effects_only=*/false);
   finish_remote_options(out.remote);
   return out;
 }
@@ -137,7 +114,7 @@ v1::UploadedDataset upload_of(const fs::path& dir) {
   return upload;
 }
 
-v1::CalibrationOptions options_of(const RemoteCalibArgs& args) {
+v1::CalibrationOptions options_of(const CalibArgs& args) {
   v1::CalibrationOptions o;
   if (!args.params_file.empty()) o.set_params_json(read_text(args.params_file));
   for (const auto& e : args.effects) o.add_effects(e);
@@ -182,9 +159,10 @@ void print_parameters(const google::protobuf::RepeatedPtrField<v1::FittedParamet
 int remote_calibration(const RemoteCalibArgs& args) {
   RemoteConnection connection(args.remote);
   auto stub = v1::CalibrationService::NewStub(connection.channel());
-  const v1::UploadedDataset dataset = upload_of(args.dataset);
-  const v1::CalibrationOptions options = options_of(args);
-  const fs::path out(args.out);
+  const CalibArgs& calib = args.calib;
+  const v1::UploadedDataset dataset = upload_of(calib.dataset);
+  const v1::CalibrationOptions options = options_of(calib);
+  const fs::path out(calib.out);
   auto context = connection.context(0);  // no deadline unless --timeout: a diagnosis takes minutes
   if (args.command == "compare") {
     v1::CompareRequest request;
@@ -200,9 +178,9 @@ int remote_calibration(const RemoteCalibArgs& args) {
     v1::FitRequest request;
     *request.mutable_dataset() = dataset;
     *request.mutable_options() = options;
-    for (const auto& h : args.holdout) request.add_holdout(h);
-    for (const auto& p : args.profile) request.add_profile(p);
-    request.set_no_initial(args.no_initial);
+    for (const auto& h : calib.holdout) request.add_holdout(h);
+    for (const auto& p : calib.profile) request.add_profile(p);
+    request.set_no_initial(!calib.initial_estimates);
     auto reader = stub->Fit(context.get(), request);
     const v1::FitResult r = read_events(*reader, "Fit").result();
     write_text(out / "params.json", r.params_json());
@@ -215,7 +193,7 @@ int remote_calibration(const RemoteCalibArgs& args) {
     v1::DiagnoseRequest request;
     *request.mutable_dataset() = dataset;
     *request.mutable_options() = options;
-    request.set_no_screening(args.no_screening);
+    request.set_no_screening(!calib.screening);
     auto reader = stub->Diagnose(context.get(), request);
     const v1::DiagnoseResult r = read_events(*reader, "Diagnose").result();
     write_text(out / "diagnosis.json", r.diagnosis_json());
