@@ -7,6 +7,7 @@
 
 #include <Eigen/SparseCore>
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "sim/levelling_crossing.h"
 #include "sim/simulator.h"
 #include "sim/static_solver.h"
+#include "sim/stiffness_matrix.h"
 #include "sim/surface_measures.h"
 
 namespace hj {
@@ -72,6 +74,44 @@ TEST(LevellingCrossing, EndsOnTheDomeTheSettleFromTheSagReaches) {
   const Eigen::MatrixXd a = point_heights(sim.mesh(), sim.state().x), b = point_heights(sim.mesh(), from_sag.x);
   EXPECT_GT(a.maxCoeff(), 0.05) << "a dome, not the sag";
   EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-5) << "m";
+}
+
+// K = -dF/dx over the free points of a settled state.
+Eigen::SparseMatrix<double> stiffness_at(const Simulator& sim) {
+  const DeviceState& state = sim.state();
+  StiffnessMatrix k(sim.mesh(), sim.model().fixed_points(state),
+                    [&](StiffnessSink& sink) { sim.model().add_stiffness(state, state.x, sink); });
+  k.set_zero();
+  sim.model().add_stiffness(state, state.x, k);
+  return k.matrix();
+}
+
+TEST(CreasedSag, ThePushLeavesTheSaddleForAStableEquilibrium) {
+  // 6 x 8 rising from the sag to 280 Pa (0.93 of levelling): the settle
+  // first reaches a creased saddle (K has a real eigenvalue near -0.06
+  // N/m). model.md: the solver must move on to the stable state beside it.
+  const ArrayGeometry g{6, 8, 0.038, 4};
+  auto rise = [&](bool check_stability) {
+    SimulatorOptions options;
+    options.fallback_max_steps = 1;
+    options.static_options.check_stability = check_stability;
+    auto sim = std::make_unique<Simulator>(g, SurfaceParameters::paper_defaults(g), options);
+    for (double p : {100.0, 200.0}) sim->apply(Action::set_pressure(p));
+    const SettleReport report = sim->apply(Action::set_pressure(280.0));
+    return std::make_pair(std::move(sim), report);
+  };
+  const auto [saddle, unchecked] = rise(false);
+  ASSERT_TRUE(unchecked.converged);
+  EXPECT_GT(divergence_mode(stiffness_at(*saddle)).size(), 0) << "without the check the settle stops on the saddle";
+
+  const auto [stable, report] = rise(true);
+  ASSERT_TRUE(report.converged);
+  EXPECT_GE(report.restarts, 1);
+  EXPECT_FALSE(report.marginal) << "the push reached another equilibrium";
+  EXPECT_LT(report.residual_n, 1e-9);
+  EXPECT_EQ(divergence_mode(stiffness_at(*stable)).size(), 0) << "and it is stable";
+  const double moved = (stable->state().x - saddle->state().x).cwiseAbs().maxCoeff();
+  EXPECT_GT(moved, 1e-4) << "m: a different surface, not the saddle again";
 }
 
 TEST(LargeDome, SettlesFromRestTo2kPaAndAcceptsItsSlowShearMode) {
