@@ -1,6 +1,6 @@
 """Client: one channel to a hapticjam-server, the bearer token on every call,
-and the PlanningService and DeviceService calls (and CalibrationService's
-Compare) as methods. A refused call
+and the PlanningService, DeviceService and CalibrationService (compare,
+fit, diagnose) calls as methods. A refused call
 raises ClientError carrying the gRPC status code and the server's message."""
 
 import json
@@ -74,6 +74,13 @@ def dataset_upload(path):
                 with open(os.path.join(folder, frame), "rb") as f:
                     session.files.add(path=frame, content=f.read())
     return dataset
+
+
+def _calibration_options(params_json="", effects=(), segments=0, threads=0, max_iterations=0):
+    """CalibrationOptions; 0 and empty mean the commands' defaults."""
+    return calibration_service_pb2.CalibrationOptions(params_json=params_json, effects=list(effects),
+                                                      segments=segments, threads=threads,
+                                                      max_iterations=max_iterations)
 
 
 def array_spec(rows, cols, segments=0, cell_size_mm=0.0):
@@ -173,25 +180,50 @@ class Client:
 
     # -- calibration --
 
-    def compare(self, dataset, params_json="", effects=(), segments=0, on_progress=None, timeout=None):
+    def compare(self, dataset, params_json="", effects=(), segments=0, threads=0, on_progress=None, timeout=None):
         """Compares the model with an UploadedDataset (dataset_upload(path));
         on_progress(CalibrationProgress) sees every progress event. Returns the
         CompareResult (summary_json, rmse_mm, mae_mm, samples, noise_floor_mm)."""
-        options = calibration_service_pb2.CalibrationOptions(params_json=params_json, effects=list(effects),
-                                                             segments=segments)
-        request = calibration_service_pb2.CompareRequest(dataset=dataset, options=options)
+        request = calibration_service_pb2.CompareRequest(
+            dataset=dataset, options=_calibration_options(params_json, effects, segments, threads))
+        return self._calibration_stream("Compare", self.calibration.Compare, request, on_progress, timeout)
+
+    def fit(self, dataset, params_json="", effects=(), segments=0, threads=0, max_iterations=0, holdout=(),
+            no_initial=False, profile=(), on_progress=None, timeout=None):
+        """Fits the model (and `effects`) to an UploadedDataset, as `hapticjam
+        fit` does; `holdout` names sessions left out and reported as held out.
+        Returns the FitResult (params_json, rmse_mm, r2, heldout_rmse_mm,
+        parameters with their 95 % intervals, noise_floor_mm)."""
+        request = calibration_service_pb2.FitRequest(
+            dataset=dataset, options=_calibration_options(params_json, effects, segments, threads, max_iterations),
+            holdout=list(holdout), no_initial=no_initial, profile=list(profile))
+        return self._calibration_stream("Fit", self.calibration.Fit, request, on_progress, timeout)
+
+    def diagnose(self, dataset, params_json="", effects=(), segments=0, threads=0, max_iterations=0,
+                 no_screening=False, on_progress=None, timeout=None):
+        """Finds the effects the data need, as `hapticjam diagnose` does
+        (`effects`: the candidates; none = all). Returns the DiagnoseResult
+        (diagnosis_json, params_json, verdict, baseline and final RMSE)."""
+        request = calibration_service_pb2.DiagnoseRequest(
+            dataset=dataset, options=_calibration_options(params_json, effects, segments, threads, max_iterations),
+            no_screening=no_screening)
+        return self._calibration_stream("Diagnose", self.calibration.Diagnose, request, on_progress, timeout)
+
+    def _calibration_stream(self, name, method, request, on_progress, timeout):
+        """Reads a calibration call's stream: progress events to on_progress,
+        then its one result."""
         result = None
         try:
-            for event in self.calibration.Compare(request, timeout=timeout, metadata=self.metadata):
+            for event in method(request, timeout=timeout, metadata=self.metadata):
                 if event.WhichOneof("event") == "progress":
                     if on_progress:
                         on_progress(event.progress)
                 else:
                     result = event.result
         except grpc.RpcError as e:
-            raise ClientError("Compare", e) from None
+            raise ClientError(name, e) from None
         if result is None:
-            raise RuntimeError("the server ended the compare stream without a result")
+            raise RuntimeError(f"the server ended the {name} stream without a result")
         return result
 
     # -- device --

@@ -16,7 +16,7 @@ import time
 import unittest
 
 import grpc
-from hapticjam_client import Client, ClientError, file_goal
+from hapticjam_client import Client, ClientError, dataset_upload, file_goal
 from hapticjam_client.client import plan_from_steps
 from hapticjam.v1 import array_pb2, planning_service_pb2
 
@@ -26,6 +26,7 @@ CLI = os.environ["HJ_CLI_PATH"]
 SHARED = os.environ["HJ_SHARED_DIR"]
 DEM = os.path.join(SHARED, "data", "dem", "volcano_maunga_whau.csv")
 MESH = os.path.join(SHARED, "data", "mesh", "openscad_letterblock.stl")
+DEMO_BASELINE = os.path.join(SHARED, "data", "sessions", "demo-baseline")  # README: M 0.52 kg, k 58 N/m
 EXAMPLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "examples")
 
 
@@ -331,6 +332,65 @@ class DeviceTest(unittest.TestCase):
         with open(path, "w") as f:
             json.dump({"steps": steps}, f)
         return path
+
+
+class CalibrationTest(unittest.TestCase):
+    """compare, fit and diagnose through the Python client, on two cheap
+    sessions of demo-baseline and on the same with a camera tilt added by
+    `hapticjam synth` (a known effect)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.rig = Rig()
+        cls.client = Client(cls.rig.address)
+        cls.baseline = os.path.join(cls.rig.folder, "baseline")
+        os.makedirs(cls.baseline)
+        for name in ("unjammed-sweep", "mixed-1"):
+            os.symlink(os.path.join(DEMO_BASELINE, name), os.path.join(cls.baseline, name))
+        cls.tilted = os.path.join(cls.rig.folder, "tilted")
+        made = subprocess.run([CLI, "synth", cls.baseline, "--out", cls.tilted, "--set", "sensor_tilt.offset_mm=1.5",
+                               "--set", "sensor_tilt.tilt_x_mrad=15"], capture_output=True, text=True, timeout=120)
+        assert made.returncode == 0, made.stderr
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.client.close()
+        cls.rig.close()
+
+    def test_fit_recovers_the_stated_mass_and_stiffness_and_reports_progress(self):
+        events = []
+        fit = self.client.fit(dataset_upload(self.baseline), holdout=["mixed-1"], on_progress=events.append,
+                               timeout=240)
+        values = {p.name: p for p in fit.parameters}
+        self.assertAlmostEqual(values["mass_kg"].value / 0.52, 1.0, delta=0.03)
+        self.assertAlmostEqual(values["spring_k"].value / 58.0, 1.0, delta=0.03)
+        self.assertLess(values["spring_k"].ci95_low, values["spring_k"].value)
+        self.assertTrue(fit.HasField("heldout_rmse_mm"))
+        self.assertLess(fit.heldout_rmse_mm, 1.2 * fit.noise_floor_mm)
+        self.assertTrue(events)
+        for e in events:
+            self.assertLessEqual(e.done, e.total)
+        # The returned params.json drives a compare at the noise floor.
+        compared = self.client.compare(dataset_upload(self.baseline), params_json=fit.params_json, timeout=120)
+        self.assertLess(compared.rmse_mm, 1.1 * compared.noise_floor_mm)
+        self.assertEqual({s["name"] for s in json.loads(compared.summary_json)["sessions"]},
+                         {"unjammed-sweep", "mixed-1"})
+
+    def test_diagnose_finds_the_camera_tilt_that_synth_added(self):
+        result = self.client.diagnose(dataset_upload(self.tilted), effects=["sensor_tilt", "bending"], timeout=240)
+        self.assertEqual(list(result.verdict), ["sensor_tilt"])
+        self.assertGreater(result.baseline_rmse_mm, 1.2 * result.noise_floor_mm)
+        self.assertLess(result.final_rmse_mm, 1.1 * result.noise_floor_mm)
+        diagnosis = json.loads(result.diagnosis_json)
+        self.assertEqual(diagnosis["ranking"][0]["effect"], "sensor_tilt")
+
+    def test_a_malformed_session_is_an_invalid_argument_naming_it(self):
+        dataset = dataset_upload(self.baseline)
+        dataset.sessions[0].session_json = "{"
+        with self.assertRaises(ClientError) as raised:
+            self.client.diagnose(dataset, timeout=60)
+        self.assertEqual(raised.exception.code, grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn(dataset.sessions[0].name, raised.exception.details)
 
 
 class TlsTest(unittest.TestCase):
