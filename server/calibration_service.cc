@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "calib/calibration_json.h"
+#include "calib/report/compare_report.h"
 #include "calib/diagnosis.h"
 #include "calib/fit_model.h"
 #include "calib/fit_parameters.h"
@@ -99,6 +100,14 @@ int max_iterations_from(const v1::CalibrationOptions& o) {
   return o.max_iterations();
 }
 
+// options.scale_mm: 0 means the command's default (5 mm).
+double heat_map_scale(const v1::CalibrationOptions& o) {
+  if (o.scale_mm() == 0.0) return 5.0;
+  if (!(o.scale_mm() > 0.0) || !std::isfinite(o.scale_mm()))
+    refuse("options.scale_mm = " + std::to_string(o.scale_mm()) + ": must be a positive number of mm");
+  return o.scale_mm();
+}
+
 std::vector<std::string> list(const google::protobuf::RepeatedPtrField<std::string>& items) {
   return {items.begin(), items.end()};
 }
@@ -171,8 +180,9 @@ grpc::Status CalibrationServiceImpl::Compare(grpc::ServerContext* context, const
     note_upload(rc, *dataset, request->ByteSizeLong());
     const ReplayOptions replay = replay_from(request->options(), limits_);
     const ModelParams params = start_model(*dataset, request->options(), replay.segments, list(request->options().effects()));
-    Compute<v1::CompareEvent> compute = [dataset, params, replay](const std::function<bool()>& interrupted,
-                                                                  const StageProgress& progress) {
+    const double scale_mm = heat_map_scale(request->options());
+    Compute<v1::CompareEvent> compute = [dataset, params, replay, scale_mm](const std::function<bool()>& interrupted,
+                                                                            const StageProgress& progress) {
       const auto start = Clock::now();
       ReplayOptions options = replay;
       options.interrupted = interrupted;
@@ -180,9 +190,19 @@ grpc::Status CalibrationServiceImpl::Compare(grpc::ServerContext* context, const
           evaluate_dataset(*dataset, params, options, [&](int done, int total, const std::string& session) {
             progress("compare", done, total, session);
           });
+      const CompareReport report =
+          compare_report(*dataset, params, evaluation, scale_mm, [&](int done, int total, const std::string& path) {
+            progress("heat maps", done, total, path);
+          });
       v1::CompareEvent event;
       v1::CompareResult* r = event.mutable_result();
-      r->set_summary_json(compare_summary_json(*dataset, params, evaluation).dump(2));
+      r->set_summary_json(report.summary.dump(2));
+      r->set_report_html(report.html);
+      for (const ReportFile& map : report.maps) {
+        v1::SessionFile* file = r->add_maps();
+        file->set_path(map.path);
+        file->set_content(map.bytes);
+      }
       r->set_rmse_mm(evaluation.rmse_mm());
       r->set_mae_mm(evaluation.mae_mm());
       r->set_samples(evaluation.samples);

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "calib/calibration_json.h"
+#include "calib/report/compare_report.h"
 #include "calib/diagnosis.h"
 #include "calib/fit_model.h"
 #include "calib/synthesize.h"
@@ -171,7 +172,7 @@ TEST_F(CalibrationService, CompareStreamsTheLibrarysComparison) {
   const auto stream = read_all(*reader);
   ASSERT_TRUE(stream.status.ok()) << stream.status.error_message();
   const auto stages = expect_progress_then_result(stream.events);
-  EXPECT_EQ(stages, std::vector<std::string>{"compare"});
+  EXPECT_EQ(stages, (std::vector<std::string>{"compare", "heat maps"}));
   const v1::CompareResult& r = stream.events.back().result();
 
   const Dataset dataset = read_dataset(dataset_dir());
@@ -184,9 +185,17 @@ TEST_F(CalibrationService, CompareStreamsTheLibrarysComparison) {
   EXPECT_NEAR(r.mae_mm(), local.mae_mm(), 1e-9);
   EXPECT_EQ(r.samples(), local.samples);
   EXPECT_NEAR(r.noise_floor_mm(), noise_floor_mm(dataset), 1e-12);
-  // The same summary.json as `hapticjam compare` writes (NaN as null in both).
-  EXPECT_EQ(nlohmann::json::parse(r.summary_json()),
-            nlohmann::json::parse(compare_summary_json(dataset, params, local).dump()));
+  // The same summary.json, report.html and heat maps as `hapticjam compare`
+  // writes (NaN as null in both).
+  const CompareReport report = compare_report(dataset, params, local, 5.0);
+  EXPECT_EQ(nlohmann::json::parse(r.summary_json()), nlohmann::json::parse(report.summary.dump()));
+  EXPECT_EQ(r.report_html(), report.html);
+  ASSERT_EQ(r.maps_size(), static_cast<int>(report.maps.size()));
+  ASSERT_EQ(r.maps_size(), dataset.capture_count());
+  for (int i = 0; i < r.maps_size(); ++i) {
+    EXPECT_EQ(r.maps(i).path(), report.maps[i].path);
+    EXPECT_TRUE(r.maps(i).content() == report.maps[i].bytes) << r.maps(i).path();
+  }
 }
 
 TEST_F(CalibrationService, FitReturnsTheLibrarysParameters) {

@@ -1,6 +1,7 @@
 // `hapticjam remote compare|fit` against the real hapticjam-server: the CLI
 // uploads a dataset folder, shows the server's stages and writes the
-// documents it returns; summary.json is the library's comparison of the
+// documents it returns; summary.json, report.html and the heat maps are
+// the library's comparison of the
 // same data, params.json loads as --params does, and a malformed session
 // is refused with exit 13 naming the file and key.
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calib/calibration_json.h"
+#include "calib/report/compare_report.h"
 #include "calib/diagnosis.h"
 #include "e2e_support.h"
 #include "scratch_dir.h"
@@ -53,8 +55,14 @@ TEST(RemoteCalibrationCli, CompareAndFitWriteTheServersDocuments) {
   replay.segments = 2;
   const Evaluation evaluation = evaluate_dataset(local, params, replay);
   const json summary = json::parse(testing_support::read_file(dir.path / "cmp" / "summary.json"));
-  EXPECT_EQ(summary, json::parse(compare_summary_json(local, params, evaluation).dump()));
+  const CompareReport report = compare_report(local, params, evaluation, 5.0);
+  EXPECT_EQ(summary, json::parse(report.summary.dump()));
   EXPECT_NEAR(summary["rmse_mm"].get<double>(), evaluation.rmse_mm(), 1e-9);
+  // report.html and every heat map, as `hapticjam compare` writes them.
+  EXPECT_TRUE(testing_support::read_file(dir.path / "cmp" / "report.html") == report.html);
+  ASSERT_EQ(report.maps.size(), static_cast<size_t>(local.capture_count()));
+  for (const ReportFile& map : report.maps)
+    EXPECT_TRUE(testing_support::read_file(dir.path / "cmp" / map.path) == map.bytes) << map.path;
 
   const CliResult fitted = cli({"fit", dataset.string(), "--segments", "2", "--max-iterations", "2", "--no-initial",
                                 "--holdout", "mixed-1", "--out", (dir.path / "fit").string()});

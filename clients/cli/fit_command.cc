@@ -10,7 +10,7 @@
 #include "calib/fit_model.h"
 #include "calib_args.h"
 #include "fit_report.h"
-#include "html_report.h"
+#include "calib/report/html_report.h"
 #include "stage_progress.h"
 
 namespace hj::cli {

@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "plot.h"
+#include "calib/report/plot.h"
 
 namespace hj::cli {
 

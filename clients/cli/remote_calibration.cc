@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "calib/report/report_file.h"
 #include "calib_args.h"
 #include "hapticjam/v1/calibration_service.grpc.pb.h"
 #include "remote_command.h"
@@ -28,11 +29,13 @@ constexpr const char* kCalibUsage =
     "usage: hapticjam remote compare|fit|diagnose DATASET --out DIR [the local command's options]\n"
     "Uploads DATASET (each session folder's session.json and the frames it names) and runs\n"
     "compare, fit or diagnose on the server, showing its progress. Writes what the server\n"
-    "returns: DIR/summary.json (compare), DIR/params.json (fit), DIR/diagnosis.json and\n"
-    "DIR/params.json (diagnose); no heat maps or report.html. Options as the local commands:\n"
+    "returns: DIR/summary.json, DIR/report.html and the heat maps DIR/maps/ (compare),\n"
+    "DIR/params.json (fit), DIR/diagnosis.json and DIR/params.json (diagnose). Options as the\n"
+    "local commands:\n"
     "  --params FILE        model parameters (hapticjam.params/1), sent with the request\n"
     "  --effects a,b        effects switched on (compare, fit) or the candidates (diagnose)\n"
     "  --segments P         mesh segments per cell edge (default 4)\n"
+    "  --scale-mm MM        compare only: the heat maps' colour scale, +-MM (default 5)\n"
     "  --threads N          threads on the server for this call (default: its cores)\n"
     "  --max-iterations N   least-squares iterations (fit, diagnose; default 20)\n"
     "  --holdout A,B        fit only: sessions left out and reported as held out\n"
@@ -48,7 +51,7 @@ struct RemoteCalibArgs {
 
 // The options each command takes, beside the remote ones and --out.
 const std::set<std::string>& allowed_options(const std::string& command) {
-  static const std::set<std::string> compare = {"--params", "--effects", "--segments", "--threads"};
+  static const std::set<std::string> compare = {"--params", "--effects", "--segments", "--threads", "--scale-mm"};
   static const std::set<std::string> fit = {"--params",  "--effects", "--segments", "--threads", "--max-iterations",
                                             "--holdout", "--no-initial", "--profile"};
   static const std::set<std::string> diagnose = {"--params",         "--effects", "--segments", "--threads",
@@ -74,11 +77,17 @@ std::string read_text(const fs::path& path) {
   return s.str();
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream out(path, std::ios::binary);
-  out << text << "\n";
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+// A JSON document as the local commands write it (with a final newline).
+void write_text(const fs::path& path, const std::string& text) { write_file(path, text + "\n"); }
+
+// A file name the server sent, to be written under --out: relative and
+// without "..", so a server cannot write outside the folder.
+fs::path safe_relative_path(const std::string& name) {
+  const fs::path path(name);
+  bool ok = !name.empty() && path.is_relative();
+  for (const auto& part : path) ok = ok && part != "..";
+  if (!ok) throw std::runtime_error("the server sent a file named \"" + name + "\": not a path inside --out");
+  return path;
 }
 
 // The dataset folder as an upload: every sub-folder holding a session.json,
@@ -121,6 +130,7 @@ v1::CalibrationOptions options_of(const CalibArgs& args) {
   o.set_segments(args.segments);
   o.set_threads(args.threads);
   o.set_max_iterations(args.max_iterations);
+  o.set_scale_mm(args.scale_mm);
   return o;
 }
 
@@ -171,9 +181,13 @@ int remote_calibration(const RemoteCalibArgs& args) {
     auto reader = stub->Compare(context.get(), request);
     const v1::CompareResult r = read_events(*reader, "Compare").result();
     write_text(out / "summary.json", r.summary_json());
+    write_file(out / "report.html", r.report_html());
+    for (const v1::SessionFile& map : r.maps()) write_file(out / safe_relative_path(map.path()), map.content());
     std::printf("%s: RMSE %.3f mm, MAE %.3f mm over %ld samples (noise floor %.3f mm), %.1f s on the server; %s\n",
                 dataset.name().c_str(), r.rmse_mm(), r.mae_mm(), static_cast<long>(r.samples()), r.noise_floor_mm(),
                 r.seconds(), (out / "summary.json").c_str());
+    std::printf("wrote %s and %d heat maps under %s\n", (out / "report.html").c_str(), r.maps_size(),
+                (out / "maps").c_str());
   } else if (args.command == "fit") {
     v1::FitRequest request;
     *request.mutable_dataset() = dataset;

@@ -2,10 +2,11 @@
 """Dataset compare: upload a dataset folder of measurement sessions to
 hapticjam-server and compare the model with it there (CalibrationService
 Compare), printing the server's progress, the RMSE per session and
-writing summary.json (what `hapticjam compare` writes).
+writing summary.json and, with --report, the self-contained report.html
+(what `hapticjam compare` writes).
 
     PYTHONPATH=build/clients/python:clients/python python3 clients/python/examples/dataset_compare.py \
-        --server 127.0.0.1:50051 ../shared/data/sessions/demo-baseline --out summary.json
+        --server 127.0.0.1:50051 ../shared/data/sessions/demo-baseline --out summary.json --report report.html
 """
 
 import argparse
@@ -22,6 +23,7 @@ def main():
     p.add_argument("--token", default=None)
     p.add_argument("--params", default=None, help="a hapticjam.params/1 file (e.g. from fit)")
     p.add_argument("--out", default=None, help="write the returned summary.json here")
+    p.add_argument("--report", default=None, help="write the returned report.html (heat maps embedded) here")
     args = p.parse_args()
     params = open(args.params).read() if args.params else ""
 
@@ -43,6 +45,9 @@ def main():
     if args.out:
         with open(args.out, "w") as f:
             f.write(result.summary_json + "\n")
+    if args.report:
+        with open(args.report, "w") as f:
+            f.write(result.report_html)
     return 0
 
 

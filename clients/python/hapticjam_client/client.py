@@ -180,12 +180,16 @@ class Client:
 
     # -- calibration --
 
-    def compare(self, dataset, params_json="", effects=(), segments=0, threads=0, on_progress=None, timeout=None):
+    def compare(self, dataset, params_json="", effects=(), segments=0, threads=0, scale_mm=0.0, on_progress=None,
+                timeout=None):
         """Compares the model with an UploadedDataset (dataset_upload(path));
         on_progress(CalibrationProgress) sees every progress event. Returns the
-        CompareResult (summary_json, rmse_mm, mae_mm, samples, noise_floor_mm)."""
-        request = calibration_service_pb2.CompareRequest(
-            dataset=dataset, options=_calibration_options(params_json, effects, segments, threads))
+        CompareResult (summary_json, rmse_mm, mae_mm, samples, noise_floor_mm,
+        report_html: a self-contained page, maps: the heat-map PNGs by path;
+        scale_mm: their colour scale, 0 = 5 mm)."""
+        options = _calibration_options(params_json, effects, segments, threads)
+        options.scale_mm = scale_mm
+        request = calibration_service_pb2.CompareRequest(dataset=dataset, options=options)
         return self._calibration_stream("Compare", self.calibration.Compare, request, on_progress, timeout)
 
     def fit(self, dataset, params_json="", effects=(), segments=0, threads=0, max_iterations=0, holdout=(),

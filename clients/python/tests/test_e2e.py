@@ -373,8 +373,14 @@ class CalibrationTest(unittest.TestCase):
         # The returned params.json drives a compare at the noise floor.
         compared = self.client.compare(dataset_upload(self.baseline), params_json=fit.params_json, timeout=120)
         self.assertLess(compared.rmse_mm, 1.1 * compared.noise_floor_mm)
-        self.assertEqual({s["name"] for s in json.loads(compared.summary_json)["sessions"]},
-                         {"unjammed-sweep", "mixed-1"})
+        summary = json.loads(compared.summary_json)
+        self.assertEqual({s["name"] for s in summary["sessions"]}, {"unjammed-sweep", "mixed-1"})
+        # A heat map per capture, named in summary.json and embedded in report.html.
+        images = [c["image"] for s in summary["sessions"] for c in s["captures"]]
+        self.assertEqual([m.path for m in compared.maps], images)
+        for m in compared.maps:
+            self.assertTrue(m.content.startswith(b"\x89PNG"), m.path)
+        self.assertEqual(compared.report_html.count("data:image/png;base64,"), len(images))
 
     def test_diagnose_finds_the_camera_tilt_that_synth_added(self):
         result = self.client.diagnose(dataset_upload(self.tilted), effects=["sensor_tilt", "bending"], timeout=240)

@@ -1,5 +1,5 @@
 // A small self-contained HTML page builder for the calibration reports:
-// headings, paragraphs, tables, images referenced by relative path, and line
+// headings, paragraphs, tables, images (by relative path or embedded), and line
 // or scatter plots (plot.h) drawn as inline SVG (no external resources).
 #pragma once
 
@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "plot.h"
+#include "calib/report/plot.h"
 
-namespace hj::cli {
+namespace hj {
 
 std::string html_escape(const std::string& text);
 std::string svg_plot(const Plot& plot, int width = 640, int height = 360);
@@ -22,6 +22,11 @@ class HtmlReport {
   void raw(const std::string& html);
   void table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
   void image(const std::string& relative_path, const std::string& caption);
+  // A PNG inside the page (a data: URI), so the page needs no other file.
+  void embedded_png(const std::string& png, const std::string& caption, int width);
+  // The whole page, and what has been added to its body.
+  std::string html() const;
+  const std::string& body() const { return body_; }
   // Writes the page; std::runtime_error naming the file if it cannot.
   void write(const std::filesystem::path& path) const;
 
@@ -30,4 +35,4 @@ class HtmlReport {
   std::string body_;
 };
 
-}  // namespace hj::cli
+}  // namespace hj

@@ -1,13 +1,15 @@
-#include "html_report.h"
+#include "calib/report/html_report.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
-namespace hj::cli {
+#include "calib/report/report_file.h"
+
+namespace hj {
 
 namespace {
 
@@ -131,15 +133,22 @@ void HtmlReport::image(const std::string& relative_path, const std::string& capt
            "'><figcaption>" + html_escape(caption) + "</figcaption></figure>\n";
 }
 
-void HtmlReport::write(const std::filesystem::path& path) const {
-  std::ofstream out(path);
+void HtmlReport::embedded_png(const std::string& png, const std::string& caption, int width) {
+  body_ += "<figure><img src='data:image/png;base64," + base64(png) + "' width='" + std::to_string(width) +
+           "' alt='" + html_escape(caption) + "'><figcaption>" + html_escape(caption) + "</figcaption></figure>\n";
+}
+
+std::string HtmlReport::html() const {
+  std::ostringstream out;
   out << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" << html_escape(title_)
       << "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:1em auto}"
          "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
          "figure{display:inline-block;margin:4px}figcaption{font-size:12px}</style></head>\n<body>\n<h1>"
       << html_escape(title_) << "</h1>\n"
       << body_ << "</body></html>\n";
-  if (!out) throw std::runtime_error(path.string() + ": cannot write the report");
+  return out.str();
 }
 
-}  // namespace hj::cli
+void HtmlReport::write(const std::filesystem::path& path) const { write_file(path, html()); }
+
+}  // namespace hj

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace hj::cli {
+namespace hj {
 
 struct PlotSeries {
   std::string name;
@@ -37,4 +37,4 @@ struct Plot {
 // The series' colour, or the palette's (ten Tableau colours) for its index.
 std::string series_colour(const PlotSeries& series, std::size_t index);
 
-}  // namespace hj::cli
+}  // namespace hj

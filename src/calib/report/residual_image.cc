@@ -1,4 +1,4 @@
-#include "residual_image.h"
+#include "calib/report/residual_image.h"
 
 #include <cmath>
 #include <cstdio>
@@ -6,7 +6,9 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
-namespace hj::cli {
+#include "calib/report/report_file.h"
+
+namespace hj {
 
 namespace {
 
@@ -26,8 +28,8 @@ cv::Vec3b diverging(double t) {
 
 }  // namespace
 
-void write_residual_png(const std::filesystem::path& path, const Session& session, const Eigen::MatrixXd& residual_mm,
-                        double scale_mm, const std::vector<std::pair<int, int>>& pinned, const std::string& title) {
+std::string residual_png(const Session& session, const Eigen::MatrixXd& residual_mm, double scale_mm,
+                         const std::vector<std::pair<int, int>>& pinned, const std::string& title) {
   const int ny = static_cast<int>(residual_mm.rows()), nx = static_cast<int>(residual_mm.cols());
   const int map_w = nx * kPixelsPerSample, map_h = ny * kPixelsPerSample;
   cv::Mat image(map_h + kTitleHeight + 8, map_w + kLegendWidth, CV_8UC3, cv::Scalar(255, 255, 255));
@@ -73,8 +75,14 @@ void write_residual_png(const std::filesystem::path& path, const Session& sessio
   }
   cv::putText(image, "mm", {bar_x, bar_top + bar_h + 14}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1,
               cv::LINE_AA);
-  std::filesystem::create_directories(path.parent_path());
-  if (!cv::imwrite(path.string(), image)) throw std::runtime_error(path.string() + ": cannot write the image");
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", image, png)) throw std::runtime_error("cannot encode the heat map \"" + title + "\"");
+  return {png.begin(), png.end()};
 }
 
-}  // namespace hj::cli
+void write_residual_png(const std::filesystem::path& path, const Session& session, const Eigen::MatrixXd& residual_mm,
+                        double scale_mm, const std::vector<std::pair<int, int>>& pinned, const std::string& title) {
+  write_file(path, residual_png(session, residual_mm, scale_mm, pinned, title));
+}
+
+}  // namespace hj
