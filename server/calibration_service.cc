@@ -7,6 +7,7 @@
 
 #include "calib/calibration_json.h"
 #include "calib/report/compare_report.h"
+#include "calib/report/fit_report_html.h"
 #include "calib/diagnosis.h"
 #include "calib/fit_model.h"
 #include "calib/fit_parameters.h"
@@ -264,6 +265,7 @@ grpc::Status CalibrationServiceImpl::Fit(grpc::ServerContext* context, const v1:
       add_parameters(report.joint, r->mutable_parameters());
       r->set_noise_floor_mm(noise_floor_mm(*all));
       r->set_seconds(seconds);
+      r->set_report_html(fit_report_html(all->dir.filename().string(), report, heldout));
       return event;
     };
     v1::FitEvent last;

@@ -11,6 +11,7 @@
 
 #include "calib/calibration_json.h"
 #include "calib/report/compare_report.h"
+#include "calib/report/fit_report_html.h"
 #include "calib/diagnosis.h"
 #include "calib/fit_model.h"
 #include "calib/synthesize.h"
@@ -250,6 +251,9 @@ TEST_F(CalibrationService, FitReturnsTheLibrarysParameters) {
     ADD_FAILURE() << "no parameter " << name;
     return 0.0;
   };
+  // report.html as `hapticjam fit` writes it.
+  EXPECT_EQ(r.report_html(), fit_report_html(dataset_dir().filename().string(), local,
+                                              {{"sessions", nlohmann::json::array()}}));
   EXPECT_NEAR(fitted("mass_kg"), truth().surface.mass_kg, 0.03 * truth().surface.mass_kg);
   EXPECT_NEAR(fitted("spring_k"), truth().surface.spring_k, 0.03 * truth().surface.spring_k);
   EXPECT_LT(r.rmse_mm(), 1.1 * r.noise_floor_mm());

@@ -73,6 +73,9 @@ TEST(RemoteCalibrationCli, CompareAndFitWriteTheServersDocuments) {
   EXPECT_EQ(doc["heldout"]["sessions"], json::array({"mixed-1"}));
   EXPECT_TRUE(doc["heldout"].contains("rmse_mm"));
   EXPECT_NO_THROW(read_model_params(dir.path / "fit" / "params.json", params.surface));
+  const std::string fit_html = testing_support::read_file(dir.path / "fit" / "report.html");
+  for (const char* part : {"hapticjam fit: small", "Joint bounded least squares", "spring_k", "Held-out sessions"})
+    EXPECT_NE(fit_html.find(part), std::string::npos) << part;
 
   // A session whose step names a cell outside the 3 x 4 array.
   std::ofstream(dataset / "mixed-1" / "session.json") << R"({"format": "hapticjam.session/1",

@@ -10,7 +10,8 @@
 #include "calib/fit_model.h"
 #include "calib_args.h"
 #include "fit_report.h"
-#include "calib/report/html_report.h"
+#include "calib/report/fit_report_html.h"
+#include "calib/report/report_file.h"
 #include "stage_progress.h"
 
 namespace hj::cli {
@@ -69,44 +70,7 @@ int fit(const CalibArgs& args) {
   const std::filesystem::path out(args.out);
   write_model_params(out / "params.json", joint.params, extra);
 
-  HtmlReport html("hapticjam fit: " + all.dir.filename().string());
-  char line[512];
-  if (report.levelling.found) {
-    std::snprintf(line, sizeof line,
-                  "Levelling: the centre crosses the level at %.1f Pa (between %.0f and %.0f Pa in %s), so M = P A / g "
-                  "= %.4f kg (95 %%: %.4f .. %.4f kg, from the crossing's profile over %d captures, scatter %.2f mm).",
-                  report.levelling.pressure_pa, report.levelling.below_pa, report.levelling.above_pa,
-                  report.levelling.session.c_str(), report.levelling.mass_kg, report.levelling.mass_low_kg,
-                  report.levelling.mass_high_kg, report.levelling.points, report.levelling.scatter_mm);
-    html.paragraph(line);
-  } else {
-    html.paragraph("Levelling: no unjammed session crosses the level; the mass starts from the given value.");
-  }
-  for (const auto& s : report.stiffnesses) {
-    std::snprintf(line, sizeof line, "Algorithm 1 (bisection) for %s over %d captures: %.5g%s.", s.parameter.c_str(),
-                  s.result.captures, s.result.value, s.result.bracketed ? "" : " (not bracketed; start value kept)");
-    html.paragraph(line);
-  }
-  std::snprintf(line, sizeof line, "Joint bounded least squares (%d iterations): RMSE %.3f mm, r^2 = %.5f over %ld samples.",
-                joint.iterations, joint.rmse_mm, joint.r2, joint.residual_count);
-  html.paragraph(line);
-  std::vector<std::vector<std::string>> rows;
-  for (const auto& e : joint.estimates) {
-    auto num = [](double v) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%.5g", v);
-      return std::string(b);
-    };
-    rows.push_back({e.parameter.qualified_name(), num(e.value), e.parameter.spec.unit,
-                    e.active ? num(e.std_error) : "-",
-                    e.active ? num(e.ci95_low) + " .. " + num(e.ci95_high) + " (" + e.interval_method + ")"
-                             : "not estimated (no effect)",
-                    e.loose ? "loose" : ""});
-  }
-  html.table({"parameter", "value", "unit", "std. error", "95 % interval", ""}, rows);
-  for (const auto& n : notes) html.paragraph(n);
-  if (heldout.contains("rmse_mm")) html.paragraph("Held-out sessions: RMSE " + heldout["rmse_mm"].dump() + " mm.");
-  html.write(out / "report.html");
+  write_file(out / "report.html", fit_report_html(all.dir.filename().string(), report, heldout));
 
   std::printf("fit %s (%zu sessions, %ld samples): RMSE %.3f mm, r^2 %.5f\n", all.dir.filename().c_str(),
               train.sessions.size(), joint.residual_count, joint.rmse_mm, joint.r2);

@@ -30,7 +30,8 @@ constexpr const char* kCalibUsage =
     "Uploads DATASET (each session folder's session.json and the frames it names) and runs\n"
     "compare, fit or diagnose on the server, showing its progress. Writes what the server\n"
     "returns: DIR/summary.json, DIR/report.html and the heat maps DIR/maps/ (compare),\n"
-    "DIR/params.json (fit), DIR/diagnosis.json and DIR/params.json (diagnose). Options as the\n"
+    "DIR/params.json and DIR/report.html (fit), DIR/diagnosis.json and DIR/params.json\n"
+    "(diagnose). Options as the\n"
     "local commands:\n"
     "  --params FILE        model parameters (hapticjam.params/1), sent with the request\n"
     "  --effects a,b        effects switched on (compare, fit) or the candidates (diagnose)\n"
@@ -198,6 +199,7 @@ int remote_calibration(const RemoteCalibArgs& args) {
     auto reader = stub->Fit(context.get(), request);
     const v1::FitResult r = read_events(*reader, "Fit").result();
     write_text(out / "params.json", r.params_json());
+    write_file(out / "report.html", r.report_html());
     std::printf("fit %s: RMSE %.3f mm, r^2 %.5f (noise floor %.3f mm), %.1f s on the server\n", dataset.name().c_str(),
                 r.rmse_mm(), r.r2(), r.noise_floor_mm(), r.seconds());
     print_parameters(r.parameters());
