@@ -12,6 +12,7 @@
 #include "model/action.h"
 #include "sim/effect_registry.h"
 #include "sim/implicit_flow.h"
+#include "sim/mesh_folds.h"
 #include "sim/simulator.h"
 
 namespace hj {
@@ -114,6 +115,40 @@ TEST(JamPinSkip, ChangesNoResult) {
     EXPECT_LT(largest, 1e-9) << "after " << step.describe();
   }
   EXPECT_EQ(skipped, 10);  // every jam and pin here starts at equilibrium
+}
+
+}  // namespace
+}  // namespace hj
+
+namespace hj {
+namespace {
+
+// A 2 x 2 mesh (p = 4) with one point pushed back past its x neighbour:
+// the segment pair at it turns back, a fold; the flat mesh has none.
+TEST(MeshFolds, FindsAFoldedPointAndNamesIt) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  Eigen::Matrix3Xd x = mesh.rest_positions();
+  EXPECT_EQ(find_mesh_folds(mesh, x).count, 0);
+  EXPECT_EQ(find_mesh_folds(mesh, x).describe(), "");
+  // Point (3, 4) moves 1.5 h back along -x, to 2.5 h: the segment from
+  // (3, 3) to it points along -x, the ones before and after along +x, so
+  // the pairs at (3, 3) and (3, 4) turn back by 180 degrees; at (3, 5) both
+  // point along +x. Along y the pair at (3, 4), (-1.5 h, h) then (1.5 h, h),
+  // bends by 112.6 degrees: a third fold.
+  const double h = mesh.spacing();
+  x(0, mesh.index(3, 4)) -= 1.5 * h;
+  const MeshFolds folds = find_mesh_folds(mesh, x);
+  EXPECT_EQ(folds.count, 3);
+  EXPECT_NEAR(folds.sharpest_deg, 180.0, 1e-6);
+  EXPECT_EQ(folds.row, 3);
+  EXPECT_TRUE(folds.col == 3 || folds.col == 4) << folds.col;
+  EXPECT_EQ(folds.axis, 'x');
+  EXPECT_EQ(folds.describe().rfind("the mesh is folded at 3 places, sharpest 180 degrees at point (3, ", 0), 0u)
+      << folds.describe();
+  // A bend of 60 degrees is no fold.
+  x = mesh.rest_positions();
+  x(2, mesh.index(3, 4)) += h * std::tan(M_PI / 6.0);  // each segment 30 degrees off: 60 at (3, 4)
+  EXPECT_EQ(find_mesh_folds(mesh, x).count, 0);
 }
 
 }  // namespace

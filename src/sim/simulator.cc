@@ -7,6 +7,7 @@
 #include "sim/effect_registry.h"
 #include "sim/jamming_springs.h"
 #include "sim/levelling_crossing.h"
+#include "sim/mesh_folds.h"
 
 namespace hj {
 
@@ -164,9 +165,11 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
   }
   keeps_equilibrium_ = false;
   if (!last_.converged) {
+    // Where the settle stopped: a folded mesh is the usual reason (mesh_folds.h).
+    const std::string folds = find_mesh_folds(m, state_.x).describe();
     state_ = before;
     throw std::runtime_error("no static equilibrium found after " + action.describe() + " (residual " +
-                             std::to_string(last_.residual_n) + " N)");
+                             std::to_string(last_.residual_n) + " N" + (folds.empty() ? "" : "; " + folds) + ")");
   }
   return last_;
 }
