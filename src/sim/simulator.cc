@@ -7,6 +7,7 @@
 #include "sim/effect_registry.h"
 #include "sim/jamming_springs.h"
 #include "sim/levelling_crossing.h"
+#include "sim/mesh_folds.h"
 
 namespace hj {
 
@@ -20,7 +21,12 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
     : options_(std::move(options)), model_(Mesh(geometry), params, make_effects(options_.extra_effects, options_.effect_parameters)) {
   options_.static_options.validate();
   options_.explicit_options.validate();
-  if (options_.interrupted) options_.static_options.interrupted = options_.explicit_options.interrupted = options_.interrupted;
+  options_.flow_options.validate();
+  if (options_.fallback_max_steps < 0)
+    throw std::invalid_argument("simulator option fallback_max_steps must be >= 0 (0: no explicit fallback)");
+  if (options_.interrupted)
+    options_.static_options.interrupted = options_.explicit_options.interrupted = options_.flow_options.interrupted =
+        options_.interrupted;
   state_ = DeviceState::flat(model_.mesh());
   settle();
 }
@@ -43,17 +49,59 @@ void Simulator::settle_once() {
     last_ = settle_explicit(model_, state_, options_.explicit_options);
     return;
   }
+  if (keeps_equilibrium_) {
+    // A jam or pin at a stable equilibrium: still one, if the residual says so.
+    Eigen::Matrix3Xd f;
+    model_.forces(state_, state_.x, f);
+    const double residual = max_free_force(f, model_.fixed_points(state_));
+    if (residual < options_.static_options.force_tolerance_n) {
+      last_ = SettleReport{true};
+      last_.residual_n = residual;
+      return;
+    }
+  }
   const Eigen::Matrix3Xd before = state_.x;
   last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
-  if (last_.converged) return;
-  // Safe fallback: relax dynamically from the previous state, then polish.
+  if (!last_.converged) settle_fallbacks(before);
+}
+
+void Simulator::settle_fallbacks(const Eigen::Matrix3Xd& before) {
+  SettleReport spent = last_;
+  const auto polish = [&](const SettleReport& fallback) {
+    spent.iterations += fallback.iterations;
+    spent.seconds += fallback.seconds;
+    last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
+    last_.iterations += spent.iterations;
+    last_.seconds += spent.seconds;
+    last_.restarts += spent.restarts;
+    spent = last_;
+    return last_.converged;
+  };
+  if (options_.flow_fallback) {
+    state_.x = before;
+    // A polish that pushes off a saddle and does not settle again leaves the
+    // state beside it: flow on from there.
+    constexpr int kRounds = 3;
+    for (int round = 0; round < kRounds; ++round) {
+      const SettleReport flow = settle_implicit_flow(model_, state_, options_.flow_options);
+      if (!flow.converged) {
+        spent.iterations += flow.iterations;
+        spent.seconds += flow.seconds;
+        break;
+      }
+      if (polish(flow)) return;
+    }
+  }
+  if (options_.fallback_max_steps == 0) {
+    last_ = spent;
+    last_.converged = false;
+    return;
+  }
+  // The paper's dynamics from the previous state, then polished.
   state_.x = before;
   ExplicitEulerOptions fallback = options_.explicit_options;
   fallback.max_steps = std::min(fallback.max_steps, options_.fallback_max_steps);
-  const SettleReport dynamic = settle_explicit(model_, state_, fallback);
-  last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
-  last_.iterations += dynamic.iterations;
-  last_.seconds += dynamic.seconds;
+  polish(settle_explicit(model_, state_, fallback));
 }
 
 const SettleReport& Simulator::apply(const Action& action) { return apply_from(action, nullptr); }
@@ -98,6 +146,8 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
       state_.node_pinned[m.node_index(action.a, action.b)] = 0;
       break;
   }
+  keeps_equilibrium_ = options_.skip_settle_after_jam_or_pin &&
+                       (action.op == Action::Op::kJam || action.op == Action::Op::kPin);
   try {
     if (start) {
       const Eigen::Matrix3Xd cold = state_.x;
@@ -109,13 +159,17 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
     }
     if (!start || !last_.converged) settle();
   } catch (...) {
+    keeps_equilibrium_ = false;
     state_ = before;
     throw;
   }
+  keeps_equilibrium_ = false;
   if (!last_.converged) {
+    // Where the settle stopped: a folded mesh is the usual reason (mesh_folds.h).
+    const std::string folds = find_mesh_folds(m, state_.x).describe();
     state_ = before;
     throw std::runtime_error("no static equilibrium found after " + action.describe() + " (residual " +
-                             std::to_string(last_.residual_n) + " N)");
+                             std::to_string(last_.residual_n) + " N" + (folds.empty() ? "" : "; " + folds) + ")");
   }
   return last_;
 }

@@ -13,6 +13,7 @@
 #include "sim/effect_registry.h"
 #include "sim/explicit_euler.h"
 #include "sim/force_model.h"
+#include "sim/implicit_flow.h"
 #include "sim/static_solver.h"
 
 namespace hj {
@@ -23,9 +24,23 @@ struct SimulatorOptions {
   SolverKind solver = SolverKind::kStatic;
   StaticSolverOptions static_options;
   ExplicitEulerOptions explicit_options;
-  // Steps the static solver's explicit fallback may take before the
-  // settle is reported as failed (bounds the time of a hard case).
+  // Where the static solver does not settle (a snap-through: the jammed
+  // sag's equilibrium vanishes as the pressure rises), the implicit flow
+  // follows the surface to the next equilibrium, which the static solver
+  // then polishes and checks for stability (sim/implicit_flow.h).
+  bool flow_fallback = true;
+  ImplicitFlowOptions flow_options;
+  // Steps the explicit fallback, the last resort after the flow, may take
+  // before the settle is reported as failed (bounds the time of a hard
+  // case); 0: no explicit fallback.
   long fallback_max_steps = 2'000'000;
+  // A jam at equilibrium only adds positive semi-definite stiffness
+  // (phi_eq = phi) and a pin only removes DOFs: the state stays a stable
+  // equilibrium, so their settle ends at once, without building K or
+  // checking stability, when the residual is already below tolerance
+  // (79 jams of a 9 x 12 plan cost about 3 s otherwise). Unjam and unpin
+  // can destabilise and always settle in full.
+  bool skip_settle_after_jam_or_pin = true;
   // Effects beyond the baseline, by registry name, and their parameter
   // values (effect name -> parameter name -> value; missing = default).
   std::vector<std::string> extra_effects;
@@ -63,6 +78,9 @@ class Simulator {
   // if they changed the state, settles once more.
   void settle();
   void settle_once();
+  // The static solver failed from `before`: the implicit flow, then the
+  // explicit fallback, each polished by the static solver.
+  void settle_fallbacks(const Eigen::Matrix3Xd& before);
   const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
   SimulatorOptions options_;
@@ -70,6 +88,8 @@ class Simulator {
   DeviceState state_;
   SettleReport last_;
   SettleMemory settle_memory_;
+  // Set by apply_from while a jam or pin settles (skip_settle_after_jam_or_pin).
+  bool keeps_equilibrium_ = false;
 };
 
 // Parses "static" / "explicit"; std::invalid_argument otherwise.
