@@ -83,7 +83,9 @@ TEST_P(OptionalEffectDerivatives, StiffnessIsMinusTheForceJacobian) {
     const auto check = testing_support::check_stiffness(*b.effect, ctx, b.fixed);
     EXPECT_LE(check.error(), 1e-5 * check.analytic.norm() + 1e-9)
         << c.effect << ": |K - K_fd| = " << check.error() << ", |K| = " << check.analytic.norm();
-    if (c.active && !flat) EXPECT_GT(check.analytic.norm(), 0.0) << "a switched-on effect has stiffness";
+    if (c.active && !flat) {
+      EXPECT_GT(check.analytic.norm(), 0.0) << "a switched-on effect has stiffness";
+    }
   }
 }
 
@@ -97,7 +99,9 @@ TEST_P(OptionalEffectDerivatives, ConservativeForceIsMinusTheEnergyGradient) {
     const ForceContext ctx{jammed_device().mesh(), jammed_device().params(), state};
     if (!b.effect->energy(ctx, state.x)) return;  // a follower load
     const auto check = testing_support::check_energy_gradient(*b.effect, ctx, b.fixed);
-    if (c.active && !flat) ASSERT_GT(check.force.norm(), 0.0);
+    if (c.active && !flat) {
+      ASSERT_GT(check.force.norm(), 0.0);
+    }
     EXPECT_LE(check.error(), 1e-6 * check.force.norm() + 1e-12)
         << c.effect << ": |F| = " << check.force.norm() << ", |F + grad E| = " << check.error();
   }

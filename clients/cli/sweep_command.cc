@@ -188,10 +188,13 @@ int sweep(const SweepArgs& args) {
   }
 
   // Fig. 11: correlation against the number of cells, one line per goal.
-  Plot fig11{"Correlation against array size (cf. Fig. 11)", "number of cells", "correlation (Eq. 12)"};
+  Plot fig11;
+  fig11.title = "Correlation against array size (cf. Fig. 11)";
+  fig11.x_label = "number of cells";
+  fig11.y_label = "correlation (Eq. 12)";
   std::map<std::string, std::size_t> index;
   for (const auto& r : rows) {
-    if (!index.count(r.goal)) index[r.goal] = fig11.series.size(), fig11.series.push_back({r.goal});
+    if (!index.count(r.goal)) index[r.goal] = fig11.series.size(), fig11.series.emplace_back().name = r.goal;
     if (r.correlation) {
       fig11.series[index[r.goal]].x.push_back(double(r.cells()));
       fig11.series[index[r.goal]].y.push_back(*r.correlation);
@@ -202,9 +205,15 @@ int sweep(const SweepArgs& args) {
   std::size_t a13 = 0;
   for (std::size_t k = 0; k < alphas.size(); ++k)
     if (std::abs(alphas[k] - 1.0 / 3.0) < 1e-12) a13 = k;
-  Plot fig13{"Correlation against the Laplace mean (cf. Fig. 13)", "Laplace mean of the goal on the mesh",
-             "correlation (Eq. 12)"};
-  for (const auto& s : fig11.series) fig13.series.push_back({s.name, {}, {}, "", false});
+  Plot fig13;
+  fig13.title = "Correlation against the Laplace mean (cf. Fig. 13)";
+  fig13.x_label = "Laplace mean of the goal on the mesh";
+  fig13.y_label = "correlation (Eq. 12)";
+  for (const auto& s : fig11.series) {
+    PlotSeries& points = fig13.series.emplace_back();
+    points.name = s.name;
+    points.lines = false;
+  }
   for (const auto& r : rows)
     if (r.correlation && a13 < r.laplace_mean.size()) {
       fig13.series[index[r.goal]].x.push_back(r.laplace_mean[a13]);
