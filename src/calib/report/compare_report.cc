@@ -12,11 +12,7 @@ namespace hj {
 
 namespace {
 
-std::string number(double v, const char* format = "%.3f") {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+std::string number(double v, const char* format = "%.3f") { return format_number(v, format); }
 
 // Per-cell RMSE as table rows, row 0 at the bottom (+y up, as the maps).
 std::vector<std::vector<std::string>> cell_rows(const Eigen::MatrixXd& cells) {

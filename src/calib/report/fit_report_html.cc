@@ -10,11 +10,7 @@ namespace hj {
 
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.5g", v);
-  return b;
-}
+std::string num(double v) { return format_number(v, "%.5g"); }
 
 }  // namespace
 

@@ -11,13 +11,15 @@
 
 namespace hj {
 
-namespace {
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
+std::string format_number(double v, const char* format) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, format, v);
   return buf;
 }
+
+namespace {
+
+std::string fmt(double v) { return format_number(v); }
 
 }  // namespace
 

@@ -12,6 +12,8 @@
 namespace hj {
 
 std::string html_escape(const std::string& text);
+// printf-style formatting of one number (e.g. "%.3f") for the reports' text.
+std::string format_number(double v, const char* format = "%.4g");
 std::string svg_plot(const Plot& plot, int width = 640, int height = 360);
 
 class HtmlReport {
