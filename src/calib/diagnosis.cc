@@ -64,24 +64,34 @@ LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& curr
   }
 }
 
+// The screening's prediction as the fit it stands for: the counts BIC
+// needs and the linearisation (residuals after the step, Jacobian, scale,
+// active columns, the current fit's session rows) cross_validate() needs.
+LeastSquaresResult predicted_fit(const ScreeningPrediction& p, const LeastSquaresResult& current) {
+  LeastSquaresResult fit;
+  fit.params = p.params;
+  fit.residual_count = p.residual_count;
+  fit.free_parameters = p.free_parameters;
+  fit.sum_sq_mm2 = p.sum_sq_mm2;
+  fit.rmse_mm = p.rmse_mm;
+  fit.residuals = p.residuals;
+  fit.jacobian = p.jacobian;
+  fit.scale = p.scale;
+  fit.active = p.active;
+  fit.session_rows = current.session_rows;
+  fit.termination = "screened: one Gauss-Newton step predicted, not refitted";
+  return fit;
+}
+
 // The held-out RMSE at the screening's predicted parameters with the
 // held-out sessions really replayed: cross_validate() on the linearisation
 // (each fold one Gauss-Newton step on the other sessions' rows, then the
 // held-out session replayed), one replay of the dataset. NaN if a replay
 // fails.
-double replayed_heldout_rmse(const Dataset& dataset, const LeastSquaresResult& current,
-                             const std::vector<FitParameter>& parameters, const ScreeningPrediction& p,
-                             const ReplayOptions& replay) {
-  LeastSquaresResult linear;
-  linear.params = p.params;
-  linear.residuals = p.residuals;
-  linear.jacobian = p.jacobian;
-  linear.scale = p.scale;
-  linear.active = p.active;
-  linear.session_rows = current.session_rows;
-  linear.rmse_mm = p.rmse_mm;
+double replayed_heldout_rmse(const Dataset& dataset, const std::vector<FitParameter>& parameters,
+                             const LeastSquaresResult& predicted, const ReplayOptions& replay) {
   try {
-    return cross_validate(dataset, parameters, linear, replay).heldout_rmse_mm;
+    return cross_validate(dataset, parameters, predicted, replay).heldout_rmse_mm;
   } catch (const std::exception&) {
     return std::numeric_limits<double>::quiet_NaN();
   }
@@ -107,13 +117,7 @@ bool screen_out(const Dataset& dataset, const LeastSquaresResult& current, doubl
     // From a start the step cannot bring back to the current fit (an effect
     // whose start is far from neutral), the linearisation says nothing.
     if (!(p.sum_sq_mm2 <= current.sum_sq_mm2)) return false;
-    LeastSquaresResult predicted;
-    predicted.params = p.params;
-    predicted.residual_count = p.residual_count;
-    predicted.free_parameters = p.free_parameters;
-    predicted.sum_sq_mm2 = p.sum_sq_mm2;
-    predicted.rmse_mm = p.rmse_mm;
-    predicted.termination = "screened: one Gauss-Newton step predicted, not refitted";
+    LeastSquaresResult predicted = predicted_fit(p, current);
     const double ratio = p.reference_heldout_rmse_mm > 0.0 ? p.heldout_rmse_mm / p.reference_heldout_rmse_mm : 1.0;
     const double gain = 1.0 - ratio;
     const double delta_bic = bic(predicted) - bic(current);
@@ -131,7 +135,7 @@ bool screen_out(const Dataset& dataset, const LeastSquaresResult& current, doubl
     // it is checked by replaying them at the folds' parameters.
     double shown_gain = gain;
     if (bic_passes) {
-      const double replayed = replayed_heldout_rmse(dataset, current, parameters, p, options.fit.least_squares.replay);
+      const double replayed = replayed_heldout_rmse(dataset, parameters, predicted, options.fit.least_squares.replay);
       // A failed replay, or a replayed gain that could pass: the refit decides.
       if (std::isnan(replayed)) return false;
       c.predicted_heldout_rmse_mm = replayed;
@@ -146,6 +150,12 @@ bool screen_out(const Dataset& dataset, const LeastSquaresResult& current, doubl
                   100.0 * shown_gain, c.heldout_replayed ? " (held-out sessions replayed)" : "",
                   100.0 * options.screen_margin * options.min_heldout_gain, delta_bic,
                   options.screen_margin * options.max_delta_bic);
+    // The fit stands for the prediction's figures, not its linearisation.
+    predicted.residuals.resize(0);
+    predicted.jacobian.resize(0, 0);
+    predicted.scale.resize(0);
+    predicted.active.clear();
+    predicted.session_rows.clear();
     c.fit = std::move(predicted);
     c.heldout_rmse_mm = c.predicted_heldout_rmse_mm;
     c.delta_bic = delta_bic;
