@@ -244,15 +244,11 @@ grpc::Status CalibrationServiceImpl::Fit(grpc::ServerContext* context, const v1:
       o.least_squares.replay.interrupted = interrupted;
       o.bisection.replay = o.least_squares.replay;
       const FitReport report = fit_model(*train, start, start.effects, o, progress);
-      nlohmann::json heldout = {{"sessions", holdout}};
-      if (!held->sessions.empty()) {
-        const Evaluation e = evaluate_dataset(*held, report.joint.params, o.least_squares.replay,
-                                              [&](int done, int total, const std::string& session) {
-                                                progress("held-out sessions", done, total, session);
-                                              });
-        heldout["rmse_mm"] = e.rmse_mm();
-        heldout["mae_mm"] = e.mae_mm();
-      }
+      const nlohmann::json heldout =
+          heldout_json(*held, holdout, report.joint.params, o.least_squares.replay,
+                       [&](int done, int total, const std::string& session) {
+                         progress("held-out sessions", done, total, session);
+                       });
       const double seconds = seconds_since(t0);
       nlohmann::json extra = fit_extra_json(*all, report, heldout, all->dir.string());
       extra["seconds"] = seconds;

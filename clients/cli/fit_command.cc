@@ -52,15 +52,9 @@ int fit(const CalibArgs& args) {
   const FitReport report = fit_model(train, start_model, start_model.effects, options, std::ref(progress));
   const LeastSquaresResult& joint = report.joint;
 
-  nlohmann::json heldout = {{"sessions", args.holdout}};
-  if (!held.sessions.empty()) {
-    const Evaluation e = evaluate_dataset(held, joint.params, options.least_squares.replay,
-                                          [&](int done, int total, const std::string& name) {
-                                            progress("held-out sessions", done, total, name);
-                                          });
-    heldout["rmse_mm"] = e.rmse_mm();
-    heldout["mae_mm"] = e.mae_mm();
-  }
+  const nlohmann::json heldout =
+      heldout_json(held, args.holdout, joint.params, options.least_squares.replay,
+                   [&](int done, int total, const std::string& name) { progress("held-out sessions", done, total, name); });
   progress.finish();
   const std::vector<std::string> notes = loose_notes(joint);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -117,6 +117,19 @@ nlohmann::json compare_summary_json(const Dataset& dataset, const ModelParams& p
   return summary;
 }
 
+nlohmann::json heldout_json(const Dataset& held, const std::vector<std::string>& names, const ModelParams& params,
+                            const ReplayOptions& replay,
+                            const std::function<void(int, int, const std::string&)>& progress) {
+  nlohmann::json out = {{"sessions", names}};
+  if (held.sessions.empty()) return out;
+  const Evaluation e = evaluate_dataset(held, params, replay, [&](int done, int total, const std::string& name) {
+    if (progress) progress(done, total, name);
+  });
+  out["rmse_mm"] = e.rmse_mm();
+  out["mae_mm"] = e.mae_mm();
+  return out;
+}
+
 nlohmann::json fit_extra_json(const Dataset& all, const FitReport& report, const nlohmann::json& heldout,
                               const std::string& dataset_name) {
   const LeastSquaresResult& joint = report.joint;

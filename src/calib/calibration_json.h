@@ -5,6 +5,7 @@
 // "cpu_seconds", "timing") and, for compare, the heat maps' file names.
 #pragma once
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -32,6 +33,13 @@ std::vector<std::string> loose_notes(const LeastSquaresResult& fit);
 // "pinned_nodes", "rmse_mm", "mae_mm", "max_mm", "mean_mm", "within_accuracy", "samples",
 // "uncovered"}]}], "cells": [{"cell": [r, c], "rmse_mm", "samples"}]}.
 nlohmann::json compare_summary_json(const Dataset& dataset, const ModelParams& params, const Evaluation& evaluation);
+
+// params.json's "heldout" of a fit: {"sessions": names} and, when `held`
+// has sessions, their "rmse_mm" and "mae_mm" replayed at `params`
+// (progress: "held-out sessions"). Shared by `hapticjam fit` and the Fit RPC.
+nlohmann::json heldout_json(const Dataset& held, const std::vector<std::string>& names, const ModelParams& params,
+                            const ReplayOptions& replay,
+                            const std::function<void(int, int, const std::string&)>& progress = {});
 
 // A fit's params.json keys beside the model (model_params_json's `extra`):
 // rmse_mm, r2, samples, noise_floor_mm, uncertainties, notes, heldout
