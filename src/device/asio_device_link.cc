@@ -1,7 +1,5 @@
 #include "device/asio_device_link.h"
 
-#include <termios.h>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -19,6 +17,7 @@
 
 #include "device/line_buffer.h"
 #include "device/protocol.h"
+#include "device/serial_line.h"
 #include "device/status_mirror.h"
 
 namespace hj::device {
@@ -117,15 +116,7 @@ struct AsioDeviceLink::Impl {
     });
     if (endpoint.kind == Endpoint::Kind::kSerial) {
       serial.emplace(io);
-      boost::system::error_code ec;
-      serial->open(endpoint.device, ec);
-      if (!ec) serial->set_option(asio::serial_port::baud_rate(options.baud_rate), ec);
-      if (!ec) serial->set_option(asio::serial_port::character_size(8), ec);
-      if (!ec) serial->set_option(asio::serial_port::parity(asio::serial_port::parity::none), ec);
-      if (!ec) serial->set_option(asio::serial_port::stop_bits(asio::serial_port::stop_bits::one), ec);
-      if (!ec) serial->set_option(asio::serial_port::flow_control(asio::serial_port::flow_control::none), ec);
-      // Whatever the device sent before (half a reply) is not for us.
-      if (!ec) ::tcflush(serial->native_handle(), TCIOFLUSH);
+      const boost::system::error_code ec = open_serial_line(*serial, endpoint.device, options.baud_rate);
       if (ec) {
         asio::post(io, [this, gen, m = ec.message()] { fail(gen, "cannot open: " + m); });
         return;
