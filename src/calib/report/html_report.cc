@@ -130,11 +130,6 @@ void HtmlReport::table(const std::vector<std::string>& header, const std::vector
   body_ += "</table>\n";
 }
 
-void HtmlReport::image(const std::string& relative_path, const std::string& caption) {
-  body_ += "<figure><img src='" + html_escape(relative_path) + "' alt='" + html_escape(caption) +
-           "'><figcaption>" + html_escape(caption) + "</figcaption></figure>\n";
-}
-
 void HtmlReport::embedded_png(const std::string& png, const std::string& caption, int width) {
   body_ += "<figure><img src='data:image/png;base64," + base64(png) + "' width='" + std::to_string(width) +
            "' alt='" + html_escape(caption) + "'><figcaption>" + html_escape(caption) + "</figcaption></figure>\n";

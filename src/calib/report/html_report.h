@@ -1,5 +1,5 @@
 // A small self-contained HTML page builder for the calibration reports:
-// headings, paragraphs, tables, images (by relative path or embedded), and line
+// headings, paragraphs, tables, embedded PNG images, and line
 // or scatter plots (plot.h) drawn as inline SVG (no external resources).
 #pragma once
 
@@ -23,7 +23,6 @@ class HtmlReport {
   void paragraph(const std::string& text);  // escaped
   void raw(const std::string& html);
   void table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
-  void image(const std::string& relative_path, const std::string& caption);
   // A PNG inside the page (a data: URI), so the page needs no other file.
   void embedded_png(const std::string& png, const std::string& caption, int width);
   // The whole page, and what has been added to its body.
