@@ -3,13 +3,13 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
-#include <iostream>
 
 #include "args.h"
+#include "calib/calibration_json.h"
 #include "calib/diagnosis.h"
+#include "calib/report/diagnose_report_html.h"
+#include "calib/report/report_file.h"
 #include "calib_args.h"
-#include "fit_report.h"
-#include "calib/report/html_report.h"
 #include "stage_progress.h"
 
 namespace hj::cli {
@@ -58,12 +58,6 @@ nlohmann::json replays_json(const ReplayTally& tally) {
   return out;
 }
 
-std::string num(double v, const char* format = "%.3f") {
-  char b[32];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
-
 int diagnose_dataset(const CalibArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
@@ -96,63 +90,9 @@ int diagnose_dataset(const CalibArgs& args) {
   write_json(out / "diagnosis.json", doc);
   write_model_params(out / "params.json", d.final_params, {{"verdict", d.verdict}});
 
-  const std::string verdict_text =
-      d.verdict.empty() ? "No effect is needed: no candidate lowers the held-out error by a real margin with a "
-                          "better BIC; the baseline explains the data."
-                        : [&] {
-                            std::string s = "The data need: ";
-                            for (size_t k = 0; k < d.verdict.size(); ++k) s += (k ? ", " : "") + d.verdict[k];
-                            return s + ".";
-                          }();
-  HtmlReport html("hapticjam diagnose: " + dataset.dir.filename().string());
-  html.heading("Verdict");
-  html.paragraph(verdict_text);
-  html.heading("Where the baseline's residual concentrates");
-  for (const auto& f : d.pattern.findings) html.paragraph(f);
-  std::vector<std::vector<std::string>> split_rows;
-  for (const auto& s : d.pattern.splits)
-    split_rows.push_back({s.name, num(s.rmse_mm), std::to_string(s.samples), s.other, num(s.other_rmse_mm),
-                          std::to_string(s.other_samples)});
-  html.table({"region", "RMSE mm", "samples", "rest", "RMSE mm", "samples"}, split_rows);
-  html.heading("Error ladder");
-  Plot plot{"Error as each chosen effect is added", "model", "RMSE (mm)", {}, {}, 0.0, d.noise_floor_mm,
-            "noise floor " + num(d.noise_floor_mm, "%.2f"), {}};
-  PlotSeries fitted{"fitted", {}, {}, "#1f77b4"}, heldout{"held out (LOSO)", {}, {}, "#d62728"};
-  for (size_t k = 0; k < d.ladder.size(); ++k) {
-    plot.x_ticks.push_back(d.ladder[k].label);
-    fitted.x.push_back(static_cast<double>(k));
-    fitted.y.push_back(d.ladder[k].rmse_mm);
-    heldout.x.push_back(static_cast<double>(k));
-    heldout.y.push_back(d.ladder[k].heldout_rmse_mm);
-  }
-  plot.series = {fitted, heldout};
-  html.raw(svg_plot(plot));
-  html.heading("Candidates on the baseline (best first)");
-  std::vector<std::vector<std::string>> rows;
-  rows.push_back({"baseline", num(base.rmse_mm), num(d.baseline_heldout_rmse_mm), "0", ""});
-  for (const auto& c : d.ranking)
-    rows.push_back({c.added, num(c.fit.rmse_mm), num(c.heldout_rmse_mm), num(c.delta_bic, "%.1f"),
-                    c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : ""});
-  html.table({"effect", "RMSE mm", "held-out RMSE mm", "delta BIC", ""}, rows);
-  if (!d.later_rounds.empty()) {
-    html.heading("Later rounds (on top of the chosen effects)");
-    rows.clear();
-    for (const auto& c : d.later_rounds) {
-      std::string on;
-      for (const auto& e : c.effects) on += (on.empty() ? "" : " + ") + e;
-      rows.push_back({on, num(c.fit.rmse_mm), num(c.heldout_rmse_mm), num(c.delta_bic, "%.1f"),
-                      c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : ""});
-    }
-    html.table({"effects", "RMSE mm", "held-out RMSE mm", "delta BIC", ""}, rows);
-  }
-  html.heading("Baseline parameters");
-  for (const auto& l : parameter_lines(base)) html.raw("<pre>" + html_escape(l) + "</pre>");
-  for (const auto& n : loose_notes(base)) html.paragraph(n);
-  html.paragraph("Significant = the leave-one-session-out RMSE falls by at least " +
-                 num(100 * options.min_heldout_gain, "%.0f") + " % and delta BIC < " +
-                 num(options.max_delta_bic, "%.0f") + ". Run time " + num(seconds, "%.1f") + " s (CPU " +
-                 num(cpu_seconds, "%.1f") + " s).");
-  html.write(out / "report.html");
+  const std::string verdict_text = verdict_sentence(d);
+  write_file(out / "report.html", diagnose_report_html(dataset.dir.filename().string(), d, options,
+                                                       DiagnoseRunTime{seconds, cpu_seconds}));
 
   std::printf("diagnose %s: baseline RMSE %.3f mm (held out %.3f), noise floor %.3f mm\n",
               dataset.dir.filename().c_str(), base.rmse_mm, d.baseline_heldout_rmse_mm, d.noise_floor_mm);

@@ -6,12 +6,13 @@
 #include <iostream>
 
 #include "args.h"
+#include "calib/calibration_json.h"
 #include "calib/diagnosis.h"
 #include "calib/fit_model.h"
-#include "calib_args.h"
-#include "fit_report.h"
 #include "calib/report/fit_report_html.h"
+#include "calib/report/parameter_lines.h"
 #include "calib/report/report_file.h"
+#include "calib_args.h"
 #include "stage_progress.h"
 
 namespace hj::cli {

@@ -1,10 +1,8 @@
-#include "fit_report.h"
+#include "calib/report/parameter_lines.h"
 
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
 
-namespace hj::cli {
+namespace hj {
 
 std::vector<std::string> parameter_lines(const LeastSquaresResult& fit) {
   std::vector<std::string> out;
@@ -32,4 +30,4 @@ std::vector<std::string> parameter_lines(const LeastSquaresResult& fit) {
   return out;
 }
 
-}  // namespace hj::cli
+}  // namespace hj
