@@ -6,9 +6,10 @@
 #include <thread>
 
 #include "calib/calibration_json.h"
-#include "calib/report/compare_report.h"
-#include "calib/report/fit_report_html.h"
 #include "calib/diagnosis.h"
+#include "calib/report/compare_report.h"
+#include "calib/report/diagnose_report_html.h"
+#include "calib/report/fit_report_html.h"
 #include "calib/fit_model.h"
 #include "calib/fit_parameters.h"
 #include "dataset_upload.h"
@@ -309,6 +310,8 @@ grpc::Status CalibrationServiceImpl::Diagnose(grpc::ServerContext* context, cons
       add_parameters(d.baseline.joint, r->mutable_baseline_parameters());
       r->set_noise_floor_mm(d.noise_floor_mm);
       r->set_seconds(seconds);
+      // Wall time only: the server's CPU clock counts every call it runs.
+      r->set_report_html(diagnose_report_html(dataset->dir.filename().string(), d, o, DiagnoseRunTime{seconds, {}}));
       return event;
     };
     v1::DiagnoseEvent last;

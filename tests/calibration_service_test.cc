@@ -1,16 +1,17 @@
 // CalibrationService over gRPC against an in-process server, on a tiny
 // synthetic dataset (3 x 4 array, two short sessions, a coarse mesh): the
-// streamed compare and fit equal the library's own on the same data,
-// progress comes before the result and does not go back within a stage, a
-// malformed upload is refused naming the file and key, cancelling or a
-// passed deadline frees the worker of a fit or diagnosis that would take
-// minutes, and a previewer may compare but not fit.
+// streamed compare, fit and diagnosis (with its report.html) equal the
+// library's own on the same data, progress comes before the result and does
+// not go back within a stage, a malformed upload is refused naming the file
+// and key, cancelling or a passed deadline frees the worker of a fit or
+// diagnosis that would take minutes, and a previewer may compare but not fit.
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "calib/calibration_json.h"
 #include "calib/report/compare_report.h"
+#include "calib/report/diagnose_report_html.h"
 #include "calib/report/fit_report_html.h"
 #include "calib/diagnosis.h"
 #include "calib/fit_model.h"
@@ -262,6 +263,46 @@ TEST_F(CalibrationService, FitReturnsTheLibrarysParameters) {
   EXPECT_NEAR(loaded.surface.mass_kg, local.joint.params.surface.mass_kg, 1e-12);
   EXPECT_NEAR(loaded.surface.spring_k, local.joint.params.surface.spring_k, 1e-9);
   EXPECT_EQ(nlohmann::json::parse(r.params_json())["dataset"], "tiny");
+}
+
+// One cheap candidate on the tiny dataset (its truth needs no effect): the
+// verdict and figures of the library's diagnosis, and report.html as
+// `hapticjam diagnose` builds it from the same diagnosis (with the run time
+// the server measured and no CPU time).
+TEST_F(CalibrationService, DiagnoseReturnsTheLibrarysDiagnosisAndItsPage) {
+  ScratchDir dir;
+  TestServer s(options(1, 4, dir.path / "q.db"), false);
+  Client c(s);
+  v1::DiagnoseRequest request;
+  *request.mutable_dataset() = upload(dataset_dir());
+  request.mutable_options()->set_segments(kSegments);
+  request.mutable_options()->set_max_iterations(2);
+  request.mutable_options()->set_threads(1);
+  request.mutable_options()->add_effects("pressure_offset");
+  auto context = call();
+  auto reader = c.stub->Diagnose(context.get(), request);
+  const auto stream = read_all(*reader);
+  ASSERT_TRUE(stream.status.ok()) << stream.status.error_message();
+  expect_progress_then_result(stream.events);
+  const v1::DiagnoseResult& r = stream.events.back().result();
+
+  const Dataset dataset = read_dataset(dataset_dir());
+  DiagnoseOptions diagnose_options;
+  diagnose_options.candidates = {"pressure_offset"};
+  diagnose_options.fit.least_squares.max_iterations = 2;
+  diagnose_options.fit.least_squares.replay.segments = kSegments;
+  diagnose_options.fit.least_squares.replay.threads = 1;
+  diagnose_options.fit.least_squares.replay = fitting_replay(diagnose_options.fit.least_squares.replay);
+  diagnose_options.fit.bisection.replay = diagnose_options.fit.least_squares.replay;
+  const Diagnosis local = diagnose(dataset, paper_start(dataset), diagnose_options);
+  EXPECT_EQ(std::vector<std::string>(r.verdict().begin(), r.verdict().end()), local.verdict);
+  EXPECT_NEAR(r.baseline_rmse_mm(), local.baseline.joint.rmse_mm, 1e-9);
+  EXPECT_NEAR(r.baseline_heldout_rmse_mm(), local.baseline_heldout_rmse_mm, 1e-9);
+  ASSERT_EQ(local.ranking.size(), 1u);
+  EXPECT_EQ(r.report_html(),
+            diagnose_report_html("tiny", local, diagnose_options, DiagnoseRunTime{r.seconds(), std::nullopt}));
+  EXPECT_NE(r.report_html().find("<h2>Error ladder</h2>\n<svg"), std::string::npos);
+  EXPECT_NE(r.report_html().find("<tr><td>pressure_offset</td>"), std::string::npos);
 }
 
 TEST_F(CalibrationService, AMalformedUploadIsRefusedNamingTheFileAndKey) {

@@ -1,15 +1,16 @@
-// `hapticjam remote compare|fit` against the real hapticjam-server: the CLI
-// uploads a dataset folder, shows the server's stages and writes the
-// documents it returns; summary.json, report.html and the heat maps are
-// the library's comparison of the
-// same data, params.json loads as --params does, and a malformed session
-// is refused with exit 13 naming the file and key.
+// `hapticjam remote compare|fit|diagnose` against the real hapticjam-server:
+// the CLI uploads a dataset folder, shows the server's stages and writes the
+// documents it returns; summary.json, report.html and the heat maps are the
+// library's comparison of the same data, params.json loads as --params does,
+// diagnose's report.html is the library's page of the same diagnosis, and a
+// malformed session is refused with exit 13 naming the file and key.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
 #include "calib/calibration_json.h"
 #include "calib/report/compare_report.h"
+#include "calib/report/diagnose_report_html.h"
 #include "calib/diagnosis.h"
 #include "e2e_support.h"
 #include "scratch_dir.h"
@@ -33,24 +34,33 @@ fs::path small_dataset(const fs::path& dir) {
   return out;
 }
 
+// `hapticjam remote ARGS --server ...` with a generous deadline.
+CliResult remote_cli(const testing_support::Server& server, const fs::path& dir, const std::vector<std::string>& args) {
+  std::vector<std::string> all = {"remote"};
+  all.insert(all.end(), args.begin(), args.end());
+  all.insert(all.end(), {"--server", server.address(), "--timeout", "300"});
+  return testing_support::run_cli(all, dir);
+}
+
+// The server's start without --params: the paper's values for the device.
+ModelParams paper_params(const Dataset& dataset, int segments) {
+  ModelParams params;
+  params.surface = SurfaceParameters::paper_defaults(dataset.device().geometry(segments));
+  params.surface.max_pressure_pa = dataset.device().max_pressure_kpa * 1000.0;
+  return params;
+}
+
 TEST(RemoteCalibrationCli, CompareAndFitWriteTheServersDocuments) {
   testing_support::ScratchDir dir;
   testing_support::Server server(dir.path, dir.path / "queue.db");
   const fs::path dataset = small_dataset(dir.path);
-  auto cli = [&](const std::vector<std::string>& args) {
-    std::vector<std::string> all = {"remote"};
-    all.insert(all.end(), args.begin(), args.end());
-    all.insert(all.end(), {"--server", server.address(), "--timeout", "300"});
-    return testing_support::run_cli(all, dir.path);
-  };
+  auto cli = [&](const std::vector<std::string>& args) { return remote_cli(server, dir.path, args); };
 
   const CliResult compared = cli({"compare", dataset.string(), "--segments", "2", "--out", (dir.path / "cmp").string()});
   ASSERT_EQ(compared.code, 0) << compared.err;
   EXPECT_NE(compared.err.find("compare: 2/2"), std::string::npos) << "the server's progress is shown: " << compared.err;
   const Dataset local = read_dataset(dataset);
-  ModelParams params;
-  params.surface = SurfaceParameters::paper_defaults(local.device().geometry(2));
-  params.surface.max_pressure_pa = local.device().max_pressure_kpa * 1000.0;
+  const ModelParams params = paper_params(local, 2);
   ReplayOptions replay;
   replay.segments = 2;
   const Evaluation evaluation = evaluate_dataset(local, params, replay);
@@ -86,6 +96,40 @@ TEST(RemoteCalibrationCli, CompareAndFitWriteTheServersDocuments) {
   EXPECT_EQ(refused.code, 13) << refused.err;
   for (const char* part : {"INVALID_ARGUMENT", "small/mixed-1/session.json", "steps[0]", "cell"})
     EXPECT_NE(refused.err.find(part), std::string::npos) << part << " in: " << refused.err;
+}
+
+// One cheap candidate on the two sessions: diagnosis.json and params.json
+// as the server made them, and report.html byte for byte the page
+// `hapticjam diagnose` builds from the same diagnosis (with the server's
+// run time, from diagnosis.json).
+TEST(RemoteCalibrationCli, DiagnoseWritesTheServersDocumentsAndPage) {
+  testing_support::ScratchDir dir;
+  testing_support::Server server(dir.path, dir.path / "queue.db");
+  const fs::path dataset = small_dataset(dir.path);
+  const fs::path out = dir.path / "diag";
+  const CliResult diagnosed = remote_cli(server, dir.path,
+                                         {"diagnose", dataset.string(), "--segments", "2", "--max-iterations", "2",
+                                          "--threads", "1", "--effects", "pressure_offset", "--out", out.string()});
+  ASSERT_EQ(diagnosed.code, 0) << diagnosed.err;
+  EXPECT_NE(diagnosed.out.find((out / "report.html").string()), std::string::npos) << diagnosed.out;
+
+  const Dataset local = read_dataset(dataset);
+  DiagnoseOptions options;
+  options.candidates = {"pressure_offset"};
+  options.fit.least_squares.max_iterations = 2;
+  options.fit.least_squares.replay.segments = 2;
+  options.fit.least_squares.replay.threads = 1;
+  options.fit.least_squares.replay = fitting_replay(options.fit.least_squares.replay);
+  options.fit.bisection.replay = options.fit.least_squares.replay;
+  const Diagnosis d = diagnose(local, paper_params(local, 2), options);
+  const json doc = json::parse(testing_support::read_file(out / "diagnosis.json"));
+  EXPECT_EQ(doc["verdict"], json(d.verdict));
+  EXPECT_NEAR(doc["baseline"]["rmse_mm"].get<double>(), d.baseline.joint.rmse_mm, 1e-9);
+  EXPECT_NO_THROW(read_model_params(out / "params.json", paper_params(local, 2).surface));
+  const std::string html = testing_support::read_file(out / "report.html");
+  EXPECT_TRUE(html == diagnose_report_html("small", d, options, {doc["seconds"].get<double>(), std::nullopt}))
+      << html;
+  EXPECT_NE(html.find("<tr><td>pressure_offset</td>"), std::string::npos);
 }
 
 }  // namespace

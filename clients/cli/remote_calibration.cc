@@ -30,9 +30,8 @@ constexpr const char* kCalibUsage =
     "Uploads DATASET (each session folder's session.json and the frames it names) and runs\n"
     "compare, fit or diagnose on the server, showing its progress. Writes what the server\n"
     "returns: DIR/summary.json, DIR/report.html and the heat maps DIR/maps/ (compare),\n"
-    "DIR/params.json and DIR/report.html (fit), DIR/diagnosis.json and DIR/params.json\n"
-    "(diagnose). Options as the\n"
-    "local commands:\n"
+    "DIR/params.json and DIR/report.html (fit), DIR/diagnosis.json, DIR/params.json and\n"
+    "DIR/report.html (diagnose). Options as the local commands:\n"
     "  --params FILE        model parameters (hapticjam.params/1), sent with the request\n"
     "  --effects a,b        effects switched on (compare, fit) or the candidates (diagnose)\n"
     "  --segments P         mesh segments per cell edge (default 4)\n"
@@ -214,14 +213,16 @@ int remote_calibration(const RemoteCalibArgs& args) {
     const v1::DiagnoseResult r = read_events(*reader, "Diagnose").result();
     write_text(out / "diagnosis.json", r.diagnosis_json());
     write_text(out / "params.json", r.params_json());
+    write_file(out / "report.html", r.report_html());
     std::string verdict;
     for (const auto& e : r.verdict()) verdict += (verdict.empty() ? "" : ", ") + e;
     std::printf("diagnose %s: baseline RMSE %.3f mm (held out %.3f), chosen model %.3f mm (held out %.3f), noise floor "
-                "%.3f mm, %.1f s on the server\n%s\nwrote %s, %s\n",
+                "%.3f mm, %.1f s on the server\n%s\nwrote %s, %s, %s\n",
                 dataset.name().c_str(), r.baseline_rmse_mm(), r.baseline_heldout_rmse_mm(), r.final_rmse_mm(),
                 r.final_heldout_rmse_mm(), r.noise_floor_mm(), r.seconds(),
                 verdict.empty() ? "No effect is needed." : ("The data need: " + verdict + ".").c_str(),
-                (out / "diagnosis.json").c_str(), (out / "params.json").c_str());
+                (out / "diagnosis.json").c_str(), (out / "params.json").c_str(),
+                (out / "report.html").c_str());
   }
   return 0;
 }
