@@ -197,7 +197,7 @@ class Client:
         """Fits the model (and `effects`) to an UploadedDataset, as `hapticjam
         fit` does; `holdout` names sessions left out and reported as held out.
         Returns the FitResult (params_json, rmse_mm, r2, heldout_rmse_mm,
-        parameters with their 95 % intervals, noise_floor_mm)."""
+        parameters with their 95 % intervals, noise_floor_mm, report_html)."""
         request = calibration_service_pb2.FitRequest(
             dataset=dataset, options=_calibration_options(params_json, effects, segments, threads, max_iterations),
             holdout=list(holdout), no_initial=no_initial, profile=list(profile))
@@ -207,7 +207,8 @@ class Client:
                  no_screening=False, on_progress=None, timeout=None):
         """Finds the effects the data need, as `hapticjam diagnose` does
         (`effects`: the candidates; none = all). Returns the DiagnoseResult
-        (diagnosis_json, params_json, verdict, baseline and final RMSE)."""
+        (diagnosis_json, params_json, verdict, baseline and final RMSE,
+        report_html: the page with the error ladder)."""
         request = calibration_service_pb2.DiagnoseRequest(
             dataset=dataset, options=_calibration_options(params_json, effects, segments, threads, max_iterations),
             no_screening=no_screening)

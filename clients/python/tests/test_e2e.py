@@ -389,6 +389,11 @@ class CalibrationTest(unittest.TestCase):
         self.assertLess(result.final_rmse_mm, 1.1 * result.noise_floor_mm)
         diagnosis = json.loads(result.diagnosis_json)
         self.assertEqual(diagnosis["ranking"][0]["effect"], "sensor_tilt")
+        # report.html as `hapticjam diagnose` writes it: the verdict and the
+        # error ladder (baseline, + sensor_tilt; fitted and held out).
+        self.assertIn("The data need: sensor_tilt.", result.report_html)
+        self.assertEqual(result.report_html.count("<svg"), 1)
+        self.assertEqual(result.report_html.count("<circle"), 2 * len(diagnosis["ladder"]))
 
     def test_a_malformed_session_is_an_invalid_argument_naming_it(self):
         dataset = dataset_upload(self.baseline)
