@@ -33,8 +33,8 @@ constexpr const char* kDiagnoseUsage =
 // (baseline and candidates), the residual pattern.
 nlohmann::json time_split(const nlohmann::json& timing) {
   auto part_of = [](const std::string& stage) -> std::string {
-    if (stage.rfind("screening ", 0) == 0) return "screening";
-    if (stage.rfind("candidate ", 0) == 0) return "refits";
+    if (stage.rfind("screening ", 0) == 0 || stage.rfind("scan ", 0) == 0) return "screening";
+    if (stage.rfind("candidate ", 0) == 0 || stage.rfind("converging baseline + ", 0) == 0) return "refits";
     if (stage == "cross-validation" || stage == "residual pattern") return stage;
     return "baseline fit";
   };
@@ -99,8 +99,9 @@ int diagnose_dataset(const CalibArgs& args) {
   for (const auto& c : d.ranking)
     std::printf("  %-20s RMSE %.3f  held out %.3f  dBIC %10.1f %s\n", c.added.c_str(), c.fit.rmse_mm,
                 c.heldout_rmse_mm, c.delta_bic,
-                c.significant ? "significant" : c.screened_out ? ("screened out: " + c.screening_note).c_str() : "");
+                candidate_note(c).c_str());
   for (const auto& f : d.pattern.findings) std::printf("%s\n", f.c_str());
+  for (const auto& n : d.notes) std::printf("note: %s\n", n.c_str());
   for (const auto& t : progress.timing())
     std::printf("  time in %-40s %7.1f s wall %7.1f s CPU %5ld replays\n", t["stage"].get<std::string>().c_str(),
                 t["wall_s"].get<double>(), t["cpu_s"].get<double>(), t["replays"].get<long>());

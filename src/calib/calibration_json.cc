@@ -19,6 +19,7 @@ nlohmann::json candidate_json(const CandidateFit& c) {
                       {"params", model_params_json(c.fit.params)},
                       {"uncertainties", uncertainties_json(c.fit)}};
   if (c.screened_out) j["screening"] = c.screening_note;
+  if (!c.scan_note.empty()) j["scan"] = c.scan_note;
   if (c.screened)
     j["predicted"] = {{"rmse_mm", c.predicted_rmse_mm},
                       {"heldout_rmse_mm", c.predicted_heldout_rmse_mm},
@@ -186,6 +187,7 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
           {"worst_cells", worst},
           {"findings", d.pattern.findings},
           {"skipped", d.skipped},
+          {"notes", d.notes},
           {"ladder", ladder},
           {"noise_floor_mm", d.noise_floor_mm},
           {"final_params", model_params_json(d.final_params)}};

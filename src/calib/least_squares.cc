@@ -304,6 +304,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   if (progress) progress(0, options.max_iterations, std::sqrt(r0.squaredNorm() / std::max<long>(r0.size(), 1)));
   out.residual_count = model.residual_count_all();
   out.free_parameters = p;
+  out.converged = p == 0;  // nothing free: nothing to converge
 
   if (p > 0) {
     ceres::Problem::Options problem_options;
@@ -334,6 +335,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
     throw_if_interrupted(options.replay);
     out.iterations = static_cast<int>(summary.iterations.size());
     out.termination = summary.BriefReport();
+    out.converged = summary.termination_type == ceres::CONVERGENCE;
   }
 
   // The optimum's residuals and Jacobian (cached if Ceres ended on one).

@@ -61,6 +61,10 @@ struct LeastSquaresResult {
   // active parameter more, its difference columns).
   int evaluations = 0;
   std::string termination;
+  // Ceres ended by a tolerance (or nothing was free), not by the iteration
+  // cap or a failure: a model compared with another must have converged,
+  // or the other is credited with its unfinished descent.
+  bool converged = false;
   // At the optimum, for cross-validation without refitting from scratch:
   // the residuals (n), the Jacobian (n x p) in the scaled variables
   // u = value / scale of the active parameters, and each session's first

@@ -12,10 +12,15 @@ namespace {
 
 std::string num(double v, const char* format = "%.3f") { return format_number(v, format); }
 
-// A candidate's last column: significant, or why it was not refitted.
+}  // namespace
+
 std::string candidate_note(const CandidateFit& c) {
-  return c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : "";
+  std::string note = c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : "";
+  if (!c.scan_note.empty()) note += (note.empty() ? "" : "; ") + std::string("started at ") + c.scan_note;
+  return note;
 }
+
+namespace {
 
 std::vector<std::string> candidate_row(const std::string& name, const CandidateFit& c) {
   return {name, num(c.fit.rmse_mm), num(c.heldout_rmse_mm), num(c.delta_bic, "%.1f"), candidate_note(c)};
@@ -54,6 +59,8 @@ std::string diagnose_report_html(const std::string& dataset_name, const Diagnosi
   HtmlReport html("hapticjam diagnose: " + dataset_name);
   html.heading("Verdict");
   html.paragraph(verdict_sentence(d));
+  for (const auto& n : d.notes) html.paragraph("Note: " + n);
+  for (const auto& s : d.skipped) html.paragraph("Not fitted: " + s);
   html.heading("Where the baseline's residual concentrates");
   for (const auto& f : d.pattern.findings) html.paragraph(f);
   std::vector<std::vector<std::string>> split_rows;

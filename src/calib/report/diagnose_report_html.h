@@ -20,6 +20,10 @@ struct DiagnoseRunTime {
   std::optional<double> cpu_s;
 };
 
+// A candidate's last column: significant, or why it was not refitted; and
+// where the scan started it, if not at the registry defaults.
+std::string candidate_note(const CandidateFit& c);
+
 // "The data need: a, b." or that no effect is needed (the page's verdict).
 std::string verdict_sentence(const Diagnosis& diagnosis);
 

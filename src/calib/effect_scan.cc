@@ -1,0 +1,129 @@
+#include "calib/effect_scan.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "calib/least_squares.h"
+#include "calib/parallel_for.h"
+
+namespace hj {
+
+namespace {
+
+struct Direction {
+  FitParameter parameter;
+  double from = 0.0, to = 0.0;  // the start value and the bound it walks to
+};
+
+struct DirectionResult {
+  double best_sum_sq = std::numeric_limits<double>::infinity();
+  double value = 0.0;
+  int replays = 0, failed = 0;
+};
+
+// SSR of the dataset at params, replayed session after session (the
+// directions are what runs in parallel); infinity where a session has no
+// equilibrium.
+double sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& replay) {
+  ReplayOptions serial = replay;
+  serial.threads = 1;
+  double sum = 0.0;
+  for (const auto& session : dataset.sessions) {
+    try {
+      sum += session_residuals(session, params, serial).squaredNorm();
+    } catch (const SettleInterrupted&) {
+      throw;  // the caller stopped the work: not a failed replay
+    } catch (const std::exception&) {
+      return std::numeric_limits<double>::infinity();
+    }
+  }
+  return sum;
+}
+
+DirectionResult walk(const Dataset& dataset, const ModelParams& start, const Direction& d,
+                     const ReplayOptions& replay, const EffectScanOptions& options) {
+  DirectionResult out;
+  int rises = 0;
+  for (double fraction : options.fractions) {
+    const double value = d.from + fraction * (d.to - d.from);
+    ModelParams point = start;
+    set_parameter_value(point, d.parameter, value);
+    const double sum_sq = sum_of_squares(dataset, point, replay);
+    ++out.replays;
+    if (!std::isfinite(sum_sq)) {
+      ++out.failed;  // no equilibrium here: step over it
+      continue;
+    }
+    if (sum_sq < out.best_sum_sq) {
+      out.best_sum_sq = sum_sq;
+      out.value = value;
+      rises = 0;
+    } else if (++rises == 2) {
+      break;
+    }
+  }
+  return out;
+}
+
+std::string format_move(const FitParameter& p, double from, double to, double gain) {
+  char text[160];
+  std::snprintf(text, sizeof text, "%s %.4g -> %.4g (sum of squares %+.0f %%)", p.qualified_name().c_str(), from, to,
+                -100.0 * gain);
+  return text;
+}
+
+}  // namespace
+
+EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
+                             const std::vector<FitParameter>& parameters, const std::string& effect,
+                             const ReplayOptions& replay, const EffectScanOptions& options) {
+  EffectScan out;
+  out.best = start;
+  std::vector<Direction> directions;
+  for (const auto& p : parameters) {
+    if (p.surface || p.effect != effect) continue;
+    const double v = parameter_value(start, p);
+    if (v > p.spec.lower) directions.push_back({p, v, p.spec.lower});
+    if (v < p.spec.upper) directions.push_back({p, v, p.spec.upper});
+  }
+  std::vector<DirectionResult> results(directions.size() + 1);
+  // Job 0 is the start itself.
+  parallel_for(
+      static_cast<int>(results.size()),
+      [&](int k) {
+        if (k == 0) {
+          results[0].best_sum_sq = sum_of_squares(dataset, start, replay);
+          results[0].replays = 1;
+        } else {
+          results[k] = walk(dataset, start, directions[k - 1], replay, options);
+        }
+      },
+      replay.threads);
+  for (const auto& r : results) {
+    out.replays += r.replays;
+    out.failed += r.failed;
+  }
+  out.start_sum_sq_mm2 = out.best_sum_sq_mm2 = results[0].best_sum_sq;
+  if (!std::isfinite(out.start_sum_sq_mm2))
+    throw std::runtime_error("the model fails to replay the dataset with " + effect + " at its start values");
+  int best = -1;
+  for (size_t k = 1; k < results.size(); ++k)
+    if (results[k].best_sum_sq < out.best_sum_sq_mm2) {
+      out.best_sum_sq_mm2 = results[k].best_sum_sq;
+      best = static_cast<int>(k);
+    }
+  const double gain = 1.0 - out.best_sum_sq_mm2 / out.start_sum_sq_mm2;
+  if (best < 0 || gain < options.min_gain) {
+    out.best_sum_sq_mm2 = out.start_sum_sq_mm2;
+    return out;
+  }
+  const Direction& d = directions[best - 1];
+  set_parameter_value(out.best, d.parameter, results[best].value);
+  out.moved = true;
+  out.note = format_move(d.parameter, d.from, results[best].value, gain);
+  return out;
+}
+
+}  // namespace hj
