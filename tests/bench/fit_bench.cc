@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "calib/effect_scan.h"
 #include "calib/levelling.h"
 #include "calib/residuals.h"
 
@@ -55,5 +56,38 @@ void BM_LevellingMass(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(hj::levelling_mass(d, 9.81));
 }
 BENCHMARK(BM_LevellingMass)->Unit(benchmark::kMicrosecond);
+
+// diagnose's scan of one candidate (calib/effect_scan.h): bending on
+// mixed-1 at the true baseline, which has none (the start is kept after
+// the walk up stops at two rises).
+void BM_EffectScanBending(benchmark::State& state) {
+  static const hj::Dataset d = hj::select_sessions(hj::read_dataset(kBaseline), {"mixed-1"}, true);
+  const hj::ModelParams start = hj::with_effects(true_params(), {"bending"});
+  hj::ReplayOptions replay = hj::fitting_replay({});
+  replay.threads = 1;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(hj::scan_effect_start(d, start, hj::fit_parameters({"bending"}), "bending", replay));
+}
+BENCHMARK(BM_EffectScanBending)->Unit(benchmark::kMillisecond);
+
+// What a replay costs where the model has no equilibrium, as a fit or a
+// scan meets it: demo-baseline's mixed-2 with kappa_bend 0.001 N m/rad
+// fails at its 3.26 kPa step after the static solver, the implicit flow
+// and the fits' short explicit fallback have all run (seconds, against
+// about 0.05 s for a replay that settles).
+void BM_SlowFailedReplay(benchmark::State& state) {
+  const auto& s = session("mixed-2");
+  hj::ModelParams p = hj::with_effects(true_params(), {"bending"});
+  p.effect_parameters["bending"]["kappa_bend"] = 0.001;
+  const hj::ReplayOptions options = hj::fitting_replay({});
+  for (auto _ : state) {
+    try {
+      benchmark::DoNotOptimize(hj::session_residuals(s, p, options));
+      state.SkipWithError("the replay settled: no longer a failure case");
+    } catch (const std::exception&) {
+    }
+  }
+}
+BENCHMARK(BM_SlowFailedReplay)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
