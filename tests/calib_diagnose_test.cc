@@ -46,6 +46,9 @@ TEST(Diagnose, FindsTheBendingStiffnessInDemoBending) {
   EXPECT_NEAR(bending.begin()->second, 0.002, 0.0002);
   ASSERT_EQ(result.ladder.size(), 2u);
   EXPECT_LT(result.ladder[1].heldout_rmse_mm, result.ladder[0].heldout_rmse_mm);
+  // area_pressure is not refitted: screened out, or predicted far above
+  // bending's refitted held-out error (DiagnoseOptions::refit_cutoff).
+  EXPECT_TRUE(result.ranking[1].screened_out) << result.ranking[1].screening_note;
 }
 
 TEST(Diagnose, ChoosesNothingOnDemoBaseline) {

@@ -206,6 +206,25 @@ bool converge(const Dataset& dataset, const std::vector<FitParameter>& parameter
   return moved;
 }
 
+// A candidate not refitted because its predicted RMSE (screening.h) is
+// more than refit_cutoff times the held-out RMSE of a significant one
+// already refitted in this round: it keeps the prediction's figures and a
+// note, as a screened-out candidate does.
+void outrun(CandidateFit& c, const LeastSquaresResult& current, double best_heldout, const std::string& best) {
+  c.fit = LeastSquaresResult{};
+  c.fit.params = c.scanned_start ? *c.scanned_start : with_effects(current.params, c.effects);
+  c.fit.rmse_mm = c.predicted_rmse_mm;
+  c.heldout_rmse_mm = c.predicted_heldout_rmse_mm;
+  c.delta_bic = c.predicted_delta_bic;
+  c.significant = false;
+  c.screened_out = true;
+  char note[240];
+  std::snprintf(note, sizeof note,
+                "not refitted: its predicted RMSE %.3f mm cannot come near %s's refitted held-out RMSE %.3f mm",
+                c.predicted_rmse_mm, best.c_str(), best_heldout);
+  c.screening_note = note;
+}
+
 }  // namespace
 
 double bic(const LeastSquaresResult& fit) {
@@ -247,12 +266,10 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   double current_heldout = out.baseline_heldout_rmse_mm;
   std::vector<std::string> remaining = candidate_effects(options);
   for (int round = 0; round < options.max_effects && !remaining.empty(); ++round) {
-    std::vector<CandidateFit> fits;
+    std::vector<CandidateFit> fits, to_refit;
     std::string on;
     for (const auto& e : chosen) on += " + " + e;
     for (const auto& effect : remaining) {
-      // One progress stage per candidate, so that its time shows apart.
-      const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
       CandidateFit c;
       c.effects = chosen;
       c.effects.push_back(effect);
@@ -283,8 +300,28 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
           continue;
         }
       }
-      // Warm start: the current model's optimum, the new effect at its
-      // defaults. A candidate the model cannot replay is skipped and said so.
+      to_refit.push_back(std::move(c));
+    }
+    // The most promising first (by the screening's predicted RMSE), so that
+    // a candidate that cannot come near the best refitted one need not be
+    // refitted (DiagnoseOptions::refit_cutoff).
+    std::stable_sort(to_refit.begin(), to_refit.end(), [](const CandidateFit& a, const CandidateFit& b) {
+      return (a.screened ? a.predicted_rmse_mm : 0.0) < (b.screened ? b.predicted_rmse_mm : 0.0);
+    });
+    double best_heldout = std::numeric_limits<double>::infinity();
+    for (CandidateFit& c : to_refit) {
+      const std::string& effect = c.added;
+      const auto parameters = fit_parameters(c.effects);
+      if (c.screened && options.refit_cutoff > 0.0 && c.predicted_rmse_mm > options.refit_cutoff * best_heldout) {
+        outrun(c, current, best_heldout, fits.front().added);
+        fits.push_back(std::move(c));
+        continue;
+      }
+      // One progress stage per candidate, so that its time shows apart.
+      const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
+      // Warm start: the current model's optimum, the new effect where the
+      // scan found it best. A candidate the model cannot replay is skipped
+      // and said so.
       try {
         c.fit = fit_candidate(dataset, current.params, c, parameters, options,
                               [&](int iteration, int max_iterations, double rmse) {
@@ -303,7 +340,12 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
       if (progress)
         progress(stage, options.fit.least_squares.max_iterations, options.fit.least_squares.max_iterations,
                  "held out " + std::to_string(c.heldout_rmse_mm) + " mm");
-      fits.push_back(std::move(c));
+      if (c.significant && c.heldout_rmse_mm < best_heldout) {
+        best_heldout = c.heldout_rmse_mm;
+        fits.insert(fits.begin(), std::move(c));  // fits.front(): the best significant refit so far
+      } else {
+        fits.push_back(std::move(c));
+      }
     }
     std::stable_sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
       if (a.significant != b.significant) return a.significant;
