@@ -206,22 +206,32 @@ bool converge(const Dataset& dataset, const std::vector<FitParameter>& parameter
   return moved;
 }
 
-// A candidate not refitted because its predicted RMSE (screening.h) is
-// more than refit_cutoff times the held-out RMSE of a significant one
-// already refitted in this round: it keeps the prediction's figures and a
+// What a candidate's refit is expected to reach: the screening's predicted
+// RMSE, or where its linearisation says nothing (a start far from neutral),
+// the RMSE at the scan's best point, where the refit starts; infinity if
+// neither is known (then it is refitted last, and always).
+double expected_rmse(const CandidateFit& c) {
+  if (c.screened) return c.predicted_rmse_mm;
+  return std::isfinite(c.scan_rmse_mm) ? c.scan_rmse_mm : std::numeric_limits<double>::infinity();
+}
+
+// A candidate not refitted because the RMSE its refit is expected to reach
+// is more than refit_cutoff times the held-out RMSE of a significant one
+// already refitted in this round: it keeps the expected figures and a
 // note, as a screened-out candidate does.
 void outrun(CandidateFit& c, const LeastSquaresResult& current, double best_heldout, const std::string& best) {
+  const double expected = expected_rmse(c);
   c.fit = LeastSquaresResult{};
   c.fit.params = c.scanned_start ? *c.scanned_start : with_effects(current.params, c.effects);
-  c.fit.rmse_mm = c.predicted_rmse_mm;
-  c.heldout_rmse_mm = c.predicted_heldout_rmse_mm;
-  c.delta_bic = c.predicted_delta_bic;
+  c.fit.rmse_mm = expected;
+  c.heldout_rmse_mm = c.screened ? c.predicted_heldout_rmse_mm : expected;
+  c.delta_bic = c.screened ? c.predicted_delta_bic : std::numeric_limits<double>::quiet_NaN();
   c.significant = false;
   c.screened_out = true;
   char note[240];
   std::snprintf(note, sizeof note,
-                "not refitted: its predicted RMSE %.3f mm cannot come near %s's refitted held-out RMSE %.3f mm",
-                c.predicted_rmse_mm, best.c_str(), best_heldout);
+                "not refitted: its %s RMSE %.3f mm cannot come near %s's refitted held-out RMSE %.3f mm",
+                c.screened ? "predicted" : "scanned", expected, best.c_str(), best_heldout);
   c.screening_note = note;
 }
 
@@ -280,6 +290,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
         try {
           EffectScan scan = scan_effect_start(dataset, with_effects(current.params, c.effects), parameters, effect,
                                               replay, options.scan_options);
+          c.scan_rmse_mm = std::sqrt(scan.best_sum_sq_mm2 / std::max(current.residual_count, 1L));
           if (scan.moved) {
             c.scanned_start = std::move(scan.best);
             c.scan_note = scan.note;
@@ -302,17 +313,16 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
       }
       to_refit.push_back(std::move(c));
     }
-    // The most promising first (by the screening's predicted RMSE), so that
-    // a candidate that cannot come near the best refitted one need not be
-    // refitted (DiagnoseOptions::refit_cutoff).
+    // The most promising first, so that a candidate that cannot come near
+    // the best refitted one need not be refitted (refit_cutoff).
     std::stable_sort(to_refit.begin(), to_refit.end(), [](const CandidateFit& a, const CandidateFit& b) {
-      return (a.screened ? a.predicted_rmse_mm : 0.0) < (b.screened ? b.predicted_rmse_mm : 0.0);
+      return expected_rmse(a) < expected_rmse(b);
     });
     double best_heldout = std::numeric_limits<double>::infinity();
     for (CandidateFit& c : to_refit) {
       const std::string& effect = c.added;
       const auto parameters = fit_parameters(c.effects);
-      if (c.screened && options.refit_cutoff > 0.0 && c.predicted_rmse_mm > options.refit_cutoff * best_heldout) {
+      if (options.refit_cutoff > 0.0 && expected_rmse(c) > options.refit_cutoff * best_heldout) {
         outrun(c, current, best_heldout, fits.front().added);
         fits.push_back(std::move(c));
         continue;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,13 +41,14 @@ struct DiagnoseOptions {
   // up to this many times the cap; one that still has not converged is
   // reported in Diagnosis::notes.
   int max_continuations = 2;
-  // Candidates are refitted in the order of their predicted RMSE; one whose
-  // prediction exceeds this many times the held-out RMSE of a significant
-  // candidate already refitted in the round is not refitted (it could not
-  // be chosen over it). On demo-bending, bending's refit reaches 1.04 mm
-  // held out; the others are predicted at 2.4-2.7 mm and their refits
-  // (2.3-2.6 mm) cost 480 s CPU. 0: refit every candidate that passes the
-  // screening.
+  // Candidates are refitted in the order of their predicted RMSE (or, where
+  // the screening cannot predict, the RMSE at the scan's best point, where
+  // the refit starts); one whose figure exceeds this many times the
+  // held-out RMSE of a significant candidate already refitted in the round
+  // is not refitted (it could not be chosen over it). On demo-bending,
+  // bending's refit reaches 1.04 mm held out; the others are predicted at
+  // 2.4-2.7 mm and their refits (2.3-2.6 mm) cost 480 s CPU. 0: refit
+  // every candidate that passes the screening.
   double refit_cutoff = 2.0;
   EffectScanOptions scan_options;
   // A candidate whose predicted delta BIC passes but whose predicted
@@ -73,6 +75,8 @@ struct CandidateFit {
   // (sum of squares -54 %)"; empty if it kept the registry defaults.
   std::string scan_note;
   std::optional<ModelParams> scanned_start;
+  // The RMSE at the scan's best point (or the start); NaN if not scanned.
+  double scan_rmse_mm = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct LadderStep {
