@@ -322,7 +322,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
     for (CandidateFit& c : to_refit) {
       const std::string& effect = c.added;
       const auto parameters = fit_parameters(c.effects);
-      if (options.refit_cutoff > 0.0 && expected_rmse(c) > options.refit_cutoff * best_heldout) {
+      if (options.screening && options.refit_cutoff > 0.0 && expected_rmse(c) > options.refit_cutoff * best_heldout) {
         outrun(c, current, best_heldout, fits.front().added);
         fits.push_back(std::move(c));
         continue;

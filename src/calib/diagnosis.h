@@ -47,8 +47,8 @@ struct DiagnoseOptions {
   // held-out RMSE of a significant candidate already refitted in the round
   // is not refitted (it could not be chosen over it). On demo-bending,
   // bending's refit reaches 1.04 mm held out; the others are predicted at
-  // 2.4-2.7 mm and their refits (2.3-2.6 mm) cost 480 s CPU. 0: refit
-  // every candidate that passes the screening.
+  // 2.4-2.7 mm and their refits (2.3-2.6 mm) cost 480 s CPU. 0, or
+  // screening off: refit every candidate that passes the screening.
   double refit_cutoff = 2.0;
   EffectScanOptions scan_options;
   // A candidate whose predicted delta BIC passes but whose predicted
