@@ -37,9 +37,9 @@ struct DiagnoseOptions {
   // (effect_scan.h); screening and refit start from the best point found.
   bool scan = true;
   // A model the next candidates are judged against (the baseline, a chosen
-  // effect) whose fit stopped at the iteration cap is fitted on, once, for
-  // up to this many times the cap; one that still has not converged is
-  // reported in Diagnosis::notes.
+  // effect) is fitted on from its optimum once more, with a 10x tighter
+  // function tolerance, for up to this many times the cap; one that still
+  // has not converged is reported in Diagnosis::notes. 0: not fitted on.
   int max_continuations = 2;
   // Candidates are refitted in the order of their predicted RMSE (or, where
   // the screening cannot predict, the RMSE at the scan's best point, where
