@@ -25,6 +25,7 @@ void StaticSolverOptions::validate() const {
   if (!(fast_step_fraction > 0.0)) bad("fast_step_fraction", "(x h) must be > 0");
   if (max_restarts < 0) bad("max_restarts", "must be >= 0");
   if (push_iterations < 1) bad("push_iterations", "must be at least 1");
+  if (stall_iterations < 1) bad("stall_iterations", "must be at least 1");
 }
 
 namespace {
@@ -102,6 +103,9 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
   Eigen::Matrix3Xd pushed_from;
   Eigen::VectorXd pushed_mode;
   int pushed_at = -1;
+  // The residual norm when it last halved, and that iteration (stall_iterations).
+  double halved_norm = start_norm;
+  int halved_at = 0;
   // A push that has not led to another equilibrium within its budget was
   // along a mode too weak to matter: settle for the equilibrium it left.
   auto settle_for_pushed_from = [&] {
@@ -148,7 +152,15 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       residual = k.gather(f);
       mu = mu0;
       ++report.restarts;
+      halved_norm = residual.norm();
+      halved_at = it;
       continue;
+    }
+    if (const double norm = residual.norm(); norm < 0.5 * halved_norm) {
+      halved_norm = norm;
+      halved_at = it;
+    } else if (control != StepControl::kDisplacement && pushed_at < 0 && it - halved_at > options.stall_iterations) {
+      break;  // stalled: nothing to converge to
     }
     k.set_zero();
     model.add_stiffness(state, state.x, k);
