@@ -31,20 +31,20 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
   settle();
 }
 
-void Simulator::settle() {
-  settle_once();
+void Simulator::settle(bool fallbacks) {
+  settle_once(fallbacks);
   // Effects that change the state at equilibrium (jam creep) do so once per
   // settle; the surface then settles to the changed state.
   if (last_.converged && model_.after_settle(state_)) {
     const SettleReport first = last_;
-    settle_once();
+    settle_once(fallbacks);
     last_.iterations += first.iterations;
     last_.seconds += first.seconds;
     last_.restarts += first.restarts;
   }
 }
 
-void Simulator::settle_once() {
+void Simulator::settle_once(bool fallbacks) {
   if (options_.solver == SolverKind::kExplicit) {
     last_ = settle_explicit(model_, state_, options_.explicit_options);
     return;
@@ -62,7 +62,7 @@ void Simulator::settle_once() {
   }
   const Eigen::Matrix3Xd before = state_.x;
   last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
-  if (!last_.converged) settle_fallbacks(before);
+  if (!last_.converged && fallbacks) settle_fallbacks(before);
 }
 
 void Simulator::settle_fallbacks(const Eigen::Matrix3Xd& before) {
@@ -154,7 +154,7 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
       const std::vector<char> fixed = model_.fixed_points(state_);
       for (int p = 0; p < m.num_points(); ++p)
         if (!fixed[p]) state_.x.col(p) = start->col(p);
-      settle();
+      settle(/*fallbacks=*/false);
       if (!last_.converged) state_.x = cold;
     }
     if (!start || !last_.converged) settle();

@@ -70,14 +70,17 @@ class Simulator {
   // As apply(action), but the settle starts with the free points at `start`
   // (3 x N), e.g. the settled state of the same step under nearby
   // parameters, which a fit's Jacobian replays many times; fixed and pinned
-  // points stay. If that does not settle, settles from the usual start.
+  // points stay. If the static solver does not settle from there, settles
+  // from the usual start (fallbacks included), so a start that fails costs
+  // one static settle, not the whole fallback chain twice.
   const SettleReport& apply(const Action& action, const Eigen::Matrix3Xd& start);
 
  private:
   // Settles, then runs the effects' after_settle hooks (ForceModel) and,
-  // if they changed the state, settles once more.
-  void settle();
-  void settle_once();
+  // if they changed the state, settles once more. Without fallbacks: the
+  // static solver only (a trial from a start state).
+  void settle(bool fallbacks = true);
+  void settle_once(bool fallbacks);
   // The static solver failed from `before`: the implicit flow, then the
   // explicit fallback, each polished by the static solver.
   void settle_fallbacks(const Eigen::Matrix3Xd& before);
