@@ -11,7 +11,8 @@
 // each bound, to 0.1 %, 0.3 %, 1 %, 3 %, 10 %, 30 % and 100 % of the way,
 // and the dataset replayed there; a direction stops once two replays in a
 // row cost more than the best before them. Points where the model has no
-// equilibrium are stepped over. The directions run in parallel.
+// equilibrium (by default: that the static solver cannot settle without
+// the fallbacks) are stepped over. The directions run in parallel.
 #pragma once
 
 #include <string>
@@ -37,6 +38,10 @@ struct EffectScanOptions {
   // share of the start's: less is what noise moves it by.
   double min_gain = 0.01;
   std::vector<double> fractions = {1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3, 1.0};
+  // The scanned points (not the start) are replayed with the simulator's
+  // fallbacks (ReplayOptions::fallbacks); off, a point only they could
+  // settle counts as one with no equilibrium.
+  bool fallbacks = false;
 };
 
 // @param start  the current model's optimum with `effect` switched on at its

@@ -99,7 +99,8 @@ void throw_if_interrupted(const ReplayOptions& options) {
 SimulatorOptions simulator_options(const ModelParams& params, const ReplayOptions& options) {
   SimulatorOptions out;
   out.static_options = options.solver;
-  out.fallback_max_steps = options.fallback_max_steps;
+  out.fallback_max_steps = options.fallbacks ? options.fallback_max_steps : 0;
+  out.flow_fallback = options.fallbacks;
   out.interrupted = options.interrupted;
   params.apply_to(out);
   return out;

@@ -24,6 +24,10 @@ struct ReplayOptions {
   // parameters where the model has no equilibrium (the net creases just
   // below levelling), and must learn that quickly; see fitting_replay().
   long fallback_max_steps = 2'000'000;
+  // False: a settle the static solver cannot finish fails at once, without
+  // the implicit flow and explicit fallbacks (a coarse scan that only
+  // looks for a good start, effect_scan.h, and steps over such points).
+  bool fallbacks = true;
   // Polled while settling (SimulatorOptions::interrupted): true stops the
   // replay, the fit or the diagnosis with SettleInterrupted, which the
   // library's fallbacks for failed replays let through. A server sets it
