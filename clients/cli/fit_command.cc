@@ -57,7 +57,7 @@ int fit(const CalibArgs& args) {
       heldout_json(held, args.holdout, joint.params, options.least_squares.replay,
                    [&](int done, int total, const std::string& name) { progress("held-out sessions", done, total, name); });
   progress.finish();
-  const std::vector<std::string> notes = loose_notes(joint);
+  const std::vector<std::string> notes = fit_notes(report);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   nlohmann::json extra = fit_extra_json(all, report, heldout, all.dir.string());

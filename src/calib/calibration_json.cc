@@ -49,6 +49,12 @@ nlohmann::json uncertainties_json(const LeastSquaresResult& fit) {
   return out;
 }
 
+std::vector<std::string> fit_notes(const FitReport& report) {
+  std::vector<std::string> out = report.probe_notes;
+  for (std::string& n : loose_notes(report.joint)) out.push_back(std::move(n));
+  return out;
+}
+
 std::vector<std::string> loose_notes(const LeastSquaresResult& fit) {
   std::vector<std::string> out;
   char line[320];
@@ -155,7 +161,7 @@ nlohmann::json fit_extra_json(const Dataset& all, const FitReport& report, const
           {"samples", joint.residual_count},
           {"noise_floor_mm", noise_floor_mm(all)},
           {"uncertainties", uncertainties_json(joint)},
-          {"notes", loose_notes(joint)},
+          {"notes", fit_notes(report)},
           {"heldout", heldout},
           {"levelling", levelling},
           {"algorithm1", algorithm1},

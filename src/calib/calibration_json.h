@@ -27,6 +27,9 @@ nlohmann::json uncertainties_json(const LeastSquaresResult& fit);
 // Sentences about the parameters that the data constrain only loosely, and
 // which one they constrain least (with the relative widths of the others).
 std::vector<std::string> loose_notes(const LeastSquaresResult& fit);
+// A fit's notes: where the probe restarted it (FitReport::probe_notes),
+// then loose_notes of its joint fit.
+std::vector<std::string> fit_notes(const FitReport& report);
 
 // summary.json of compare: {"rmse_mm", "mae_mm", "samples", "noise_floor_mm", "params",
 // "sessions": [{"name", "captures": [{"frame", "label", "pressure_kpa", "jammed_cells",

@@ -266,6 +266,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   base_start.effects.clear();
   base_start.effect_parameters.clear();
   out.baseline = fit_model(dataset, base_start, {}, options.fit, progress);
+  for (const std::string& n : out.baseline.probe_notes) out.notes.push_back("baseline: " + n);
   const auto base_parameters = fit_parameters({});
   converge(dataset, base_parameters, options, "baseline", progress, out.baseline.joint, out.notes);
   if (progress) progress("cross-validation", 0, 1, "baseline");

@@ -23,25 +23,6 @@ struct DirectionResult {
   int replays = 0, failed = 0;
 };
 
-// SSR of the dataset at params, replayed session after session (the
-// directions are what runs in parallel); infinity where a session has no
-// equilibrium.
-double sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& replay) {
-  ReplayOptions serial = replay;
-  serial.threads = 1;
-  double sum = 0.0;
-  for (const auto& session : dataset.sessions) {
-    try {
-      sum += session_residuals(session, params, serial).squaredNorm();
-    } catch (const SettleInterrupted&) {
-      throw;  // the caller stopped the work: not a failed replay
-    } catch (const std::exception&) {
-      return std::numeric_limits<double>::infinity();
-    }
-  }
-  return sum;
-}
-
 DirectionResult walk(const Dataset& dataset, const ModelParams& start, const Direction& d,
                      ReplayOptions replay, const EffectScanOptions& options) {
   // A point is only a candidate start, so one the static solver cannot
@@ -55,7 +36,7 @@ DirectionResult walk(const Dataset& dataset, const ModelParams& start, const Dir
     const double value = d.from + fraction * (d.to - d.from);
     ModelParams point = start;
     set_parameter_value(point, d.parameter, value);
-    const double sum_sq = sum_of_squares(dataset, point, replay);
+    const double sum_sq = dataset_sum_of_squares(dataset, point, replay);
     ++out.replays;
     if (!std::isfinite(sum_sq)) {
       ++out.failed;  // no equilibrium here: step over it
@@ -99,7 +80,7 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
       static_cast<int>(results.size()),
       [&](int k) {
         if (k == 0) {
-          results[0].best_sum_sq = sum_of_squares(dataset, start, replay);
+          results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay);
           results[0].replays = 1;
         } else {
           results[k] = walk(dataset, start, directions[k - 1], replay, options);

@@ -13,6 +13,7 @@
 
 #include "calib/least_squares.h"
 #include "calib/levelling.h"
+#include "calib/optimum_probe.h"
 #include "calib/profile_likelihood.h"
 #include "calib/stiffness_bisection.h"
 
@@ -26,6 +27,11 @@ struct FitOptions {
   // constrained parameter by its profile-likelihood interval
   // (profile_likelihood.h); costs a few warm-started refits per end.
   bool profile_loose = false;
+  // After the joint fit, probe each free parameter a few standard errors
+  // away (optimum_probe.h) and, where a point is clearly better, fit again
+  // from there; up to this many times (0: never).
+  int probe_rounds = 2;
+  OptimumProbeOptions probe;
   std::vector<std::string> profile_also;  // qualified names profiled even when not loose
   ProfileOptions profile;
 };
@@ -42,6 +48,9 @@ struct FitReport {
   ModelParams initial;  // after levelling, Algorithm 1 and the refit on the bare captures
   double bare_rmse_mm = 0.0;  // of that refit (0 if not run)
   LeastSquaresResult joint;
+  // Each time the probe restarted the joint fit: where from, e.g. "the
+  // least squares restarted from mass_kg 0.51977 -> 0.52016 (...)".
+  std::vector<std::string> probe_notes;
 };
 
 // Stage ("levelling", "algorithm 1: spring_k", "least squares"), progress.

@@ -178,4 +178,20 @@ Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelPar
   return out;
 }
 
+double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options) {
+  ReplayOptions serial = options;
+  serial.threads = 1;
+  double sum = 0.0;
+  for (const auto& session : dataset.sessions) {
+    try {
+      sum += session_residuals(session, params, serial).squaredNorm();
+    } catch (const SettleInterrupted&) {
+      throw;  // the caller stopped the work: not a failed replay
+    } catch (const std::exception&) {
+      return std::numeric_limits<double>::infinity();
+    }
+  }
+  return sum;
+}
+
 }  // namespace hj

@@ -115,4 +115,10 @@ Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelPar
                                   ReplayTrace* trace = nullptr);
 int residual_count(const MeasuredSession& session);
 
+// The sum of squares of every session's residuals at params, the sessions
+// replayed one after another (for callers that run several points in
+// parallel: effect_scan.h, optimum_probe.h); infinity where a session has
+// no equilibrium. SettleInterrupted is let through.
+double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options);
+
 }  // namespace hj

@@ -44,7 +44,7 @@ std::string fit_report_html(const std::string& dataset_name, const FitReport& re
                              : "not estimated (no effect)",
                     e.loose ? "loose" : ""});
   html.table({"parameter", "value", "unit", "std. error", "95 % interval", ""}, rows);
-  for (const auto& n : loose_notes(joint)) html.paragraph(n);
+  for (const auto& n : fit_notes(report)) html.paragraph(n);
   if (heldout.contains("rmse_mm")) html.paragraph("Held-out sessions: RMSE " + heldout["rmse_mm"].dump() + " mm.");
   return html.html();
 }

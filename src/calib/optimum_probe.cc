@@ -1,0 +1,62 @@
+#include "calib/optimum_probe.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "calib/parallel_for.h"
+
+namespace hj {
+
+OptimumProbe probe_optimum(const Dataset& dataset, const LeastSquaresResult& fit, const ReplayOptions& replay,
+                           const OptimumProbeOptions& options) {
+  struct Point {
+    const ParameterEstimate* estimate;
+    double value;
+    double sum_sq = std::numeric_limits<double>::infinity();
+  };
+  std::vector<Point> points;
+  for (const ParameterEstimate& e : fit.estimates) {
+    if (!e.active || !(e.std_error > 0.0) || !std::isfinite(e.std_error)) continue;
+    for (double m : options.multiples)
+      for (double sign : {1.0, -1.0}) {
+        const double v = std::clamp(e.value + sign * m * e.std_error, e.parameter.spec.lower, e.parameter.spec.upper);
+        if (v != e.value) points.push_back({&e, v});
+      }
+  }
+  OptimumProbe out;
+  out.best = fit.params;
+  out.start_sum_sq_mm2 = out.best_sum_sq_mm2 = fit.sum_sq_mm2;
+  out.points = static_cast<int>(points.size());
+  parallel_for(
+      out.points,
+      [&](int k) {
+        ModelParams at = fit.params;
+        set_parameter_value(at, points[k].estimate->parameter, points[k].value);
+        points[k].sum_sq = dataset_sum_of_squares(dataset, at, replay);
+      },
+      replay.threads);
+  const Point* best = nullptr;
+  for (const Point& p : points) {
+    if (!std::isfinite(p.sum_sq)) ++out.failed;
+    else if (p.sum_sq < out.best_sum_sq_mm2) {
+      out.best_sum_sq_mm2 = p.sum_sq;
+      best = &p;
+    }
+  }
+  const double gain = 1.0 - out.best_sum_sq_mm2 / out.start_sum_sq_mm2;
+  if (!best || !(gain >= options.min_gain)) {
+    out.best_sum_sq_mm2 = out.start_sum_sq_mm2;
+    return out;
+  }
+  set_parameter_value(out.best, best->estimate->parameter, best->value);
+  out.moved = true;
+  char text[200];
+  std::snprintf(text, sizeof text, "%s %.6g -> %.6g (sum of squares %+.1f %%)",
+                best->estimate->parameter.qualified_name().c_str(), best->estimate->value, best->value, -100.0 * gain);
+  out.note = text;
+  return out;
+}
+
+}  // namespace hj
