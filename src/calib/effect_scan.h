@@ -8,9 +8,10 @@
 // replay settles for kappa_bend 0.001 .. 0.0014 (a limit point).
 //
 // Each of the effect's parameters is moved alone from the start toward
-// each bound, to 0.1 %, 0.3 %, 1 %, 3 %, 10 %, 30 % and 100 % of the way,
-// and the dataset replayed there; a direction stops once two replays in a
-// row cost more than the best before them. Points where the model has no
+// each bound, to 0.1 %, 0.3 %, 1 %, 3 %, 10 %, 30 %, 70 %, 90 %, 97 % and
+// 100 % of the way, and the dataset replayed there; a direction stops once
+// two replays in a row cost more than the best before them. A start that
+// does not replay gives way to the best scanned point that does. Points where the model has no
 // equilibrium (by default: that the static solver cannot settle without
 // the fallbacks) are stepped over. The directions run in parallel.
 #pragma once
@@ -37,7 +38,9 @@ struct EffectScanOptions {
   // A scanned point is taken only if it lowers the sum of squares by this
   // share of the start's: less is what noise moves it by.
   double min_gain = 0.01;
-  std::vector<double> fractions = {1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3, 1.0};
+  // The far side too: a start that is not neutral (area_pressure's weight
+  // 1 toward 0) may have the data's value near the other bound (0.1).
+  std::vector<double> fractions = {1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3, 0.7, 0.9, 0.97, 1.0};
   // The scanned points (not the start) are replayed with the simulator's
   // fallbacks (ReplayOptions::fallbacks); off, a point only they could
   // settle counts as one with no equilibrium.
@@ -46,7 +49,8 @@ struct EffectScanOptions {
 
 // @param start  the current model's optimum with `effect` switched on at its
 //               start values
-// @throws std::runtime_error if the dataset cannot be replayed at `start`
+// @throws std::runtime_error if the dataset replays neither at `start` nor
+//         at any scanned point
 EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
                              const std::vector<FitParameter>& parameters, const std::string& effect,
                              const ReplayOptions& replay, const EffectScanOptions& options = {});
