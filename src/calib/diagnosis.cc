@@ -26,9 +26,10 @@ std::vector<std::string> candidate_effects(const DiagnoseOptions& options) {
 // is about six standard errors of an RMSE estimated from 1.7e5 samples
 // (relative s.e. 1 / sqrt(2 n)), and far less than any effect worth
 // modelling changes.
-bool is_significant(const CandidateFit& c, double reference_heldout_mm, const DiagnoseOptions& options) {
+bool is_significant(const CandidateFit& c, const LeastSquaresResult& current, double reference_heldout_mm,
+                    const DiagnoseOptions& options) {
   return c.heldout_rmse_mm <= (1.0 - options.min_heldout_gain) * reference_heldout_mm &&
-         c.delta_bic < options.max_delta_bic;
+         c.delta_bic < options.max_delta_bic && c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm;
 }
 
 // The candidate starts from the current optimum with the added effect
@@ -348,7 +349,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
         if (progress) progress("cross-validation", 0, 1, effect);
         c.heldout_rmse_mm = cross_validate(dataset, parameters, c.fit, replay).heldout_rmse_mm;
         c.delta_bic = bic(c.fit) - bic(current);
-        c.significant = is_significant(c, current_heldout, options);
+        c.significant = is_significant(c, current, current_heldout, options);
       } catch (const SettleInterrupted&) {
         throw;  // the caller stopped the work: not a failed replay
       } catch (const std::exception& e) {
