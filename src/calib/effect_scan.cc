@@ -1,7 +1,6 @@
 #include "calib/effect_scan.h"
 
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -52,19 +51,6 @@ DirectionResult walk(const Dataset& dataset, const ModelParams& start, const Dir
     }
   }
   return out;
-}
-
-// "bending.kappa_bend 0 -> 0.003 (sum of squares -67 %)"; without a gain,
-// the start did not replay.
-std::string format_move(const FitParameter& p, double from, double to, std::optional<double> gain) {
-  char text[200];
-  if (gain)
-    std::snprintf(text, sizeof text, "%s %.4g -> %.4g (sum of squares %+.0f %%)", p.qualified_name().c_str(), from, to,
-                  -100.0 * *gain);
-  else
-    std::snprintf(text, sizeof text, "%s %.4g -> %.4g (the start does not replay)", p.qualified_name().c_str(), from,
-                  to);
-  return text;
 }
 
 }  // namespace
@@ -119,7 +105,8 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
   const Direction& d = directions[best - 1];
   set_parameter_value(out.best, d.parameter, results[best].value);
   out.moved = true;
-  out.note = format_move(d.parameter, d.from, results[best].value, start_replays ? std::optional<double>(gain) : std::nullopt);
+  out.note = parameter_move_note(d.parameter, d.from, results[best].value,
+                                 start_replays ? std::optional<double>(gain) : std::nullopt);
   return out;
 }
 

@@ -10,10 +10,11 @@
 // Each of the effect's parameters is moved alone from the start toward
 // each bound, to 0.1 %, 0.3 %, 1 %, 3 %, 10 %, 30 %, 70 %, 90 %, 97 % and
 // 100 % of the way, and the dataset replayed there; a direction stops once
-// two replays in a row cost more than the best before them. A start that
-// does not replay gives way to the best scanned point that does. Points where the model has no
-// equilibrium (by default: that the static solver cannot settle without
-// the fallbacks) are stepped over. The directions run in parallel.
+// two replays in a row cost more than the best before them. Points where
+// the model has no equilibrium (by default: that the static solver cannot
+// settle without the fallbacks) are stepped over; a start that does not
+// replay gives way to the best scanned point that does. The directions run
+// in parallel.
 #pragma once
 
 #include <string>

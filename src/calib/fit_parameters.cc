@@ -1,6 +1,7 @@
 #include "calib/fit_parameters.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 namespace hj {
@@ -52,6 +53,17 @@ void set_parameter_value(ModelParams& params, const FitParameter& p, double valu
   }
   params = with_effects(std::move(params), {p.effect});
   params.effect_parameters[p.effect][p.spec.name] = value;
+}
+
+std::string parameter_move_note(const FitParameter& p, double from, double to, std::optional<double> ssr_gain) {
+  char text[200];
+  if (ssr_gain)
+    std::snprintf(text, sizeof text, "%s %.6g -> %.6g (sum of squares %+.1f %%)", p.qualified_name().c_str(), from, to,
+                  -100.0 * *ssr_gain);
+  else
+    std::snprintf(text, sizeof text, "%s %.6g -> %.6g (the start does not replay)", p.qualified_name().c_str(), from,
+                  to);
+  return text;
 }
 
 }  // namespace hj

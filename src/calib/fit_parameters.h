@@ -4,6 +4,7 @@
 // followed by those of each switched-on effect.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,11 @@ struct FitParameter {
 // The baseline's parameters, then each of `effects`' in order.
 // @throws std::invalid_argument naming an unknown effect.
 std::vector<FitParameter> fit_parameters(const std::vector<std::string>& effects);
+
+// The note of a search that moved one parameter, e.g. "bending.kappa_bend
+// 0 -> 0.003 (sum of squares -67 %)" (effect_scan.h, optimum_probe.h);
+// without a gain, "(the start does not replay)".
+std::string parameter_move_note(const FitParameter& p, double from, double to, std::optional<double> ssr_gain);
 
 double parameter_value(const ModelParams& params, const FitParameter& p);
 // Sets the value, switching the effect on (with its defaults) if it is off.

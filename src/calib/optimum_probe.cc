@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "calib/parallel_for.h"
@@ -52,10 +51,7 @@ OptimumProbe probe_optimum(const Dataset& dataset, const LeastSquaresResult& fit
   }
   set_parameter_value(out.best, best->estimate->parameter, best->value);
   out.moved = true;
-  char text[200];
-  std::snprintf(text, sizeof text, "%s %.6g -> %.6g (sum of squares %+.1f %%)",
-                best->estimate->parameter.qualified_name().c_str(), best->estimate->value, best->value, -100.0 * gain);
-  out.note = text;
+  out.note = parameter_move_note(best->estimate->parameter, best->estimate->value, best->value, gain);
   return out;
 }
 
