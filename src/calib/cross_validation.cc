@@ -1,6 +1,7 @@
 #include "calib/cross_validation.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 
 #include "calib/parallel_for.h"
@@ -9,12 +10,11 @@ namespace hj {
 
 namespace {
 
-// The fold's parameters: one Gauss-Newton step from the optimum on the
-// training rows, clamped to the bounds.
-ModelParams fold_parameters(const std::vector<FitParameter>& parameters, const LeastSquaresResult& fit, int rows_begin,
-                            int rows_end) {
+// The fold's Gauss-Newton step from the optimum on the training rows, in
+// the fit's scaled variables (empty if nothing is free).
+Eigen::VectorXd fold_step(const LeastSquaresResult& fit, int rows_begin, int rows_end) {
   const int p = static_cast<int>(fit.active.size());
-  if (p == 0) return fit.params;
+  if (p == 0) return {};
   const int n = static_cast<int>(fit.residuals.size());
   Eigen::MatrixXd jtj = fit.jacobian.transpose() * fit.jacobian;
   Eigen::VectorXd jtr = fit.jacobian.transpose() * fit.residuals;
@@ -24,37 +24,86 @@ ModelParams fold_parameters(const std::vector<FitParameter>& parameters, const L
     jtj -= j_held.transpose() * j_held;
     jtr -= j_held.transpose() * fit.residuals.segment(rows_begin, held);
   }
-  // A little Levenberg damping keeps a nearly flat direction from leaping.
+  // A little Levenberg damping keeps an exactly flat direction finite.
   jtj.diagonal() *= 1.0 + 1e-6;
-  const Eigen::VectorXd step = -jtj.ldlt().solve(jtr);
+  return -jtj.ldlt().solve(jtr);
+}
+
+// The optimum moved by t * step, clamped to the bounds.
+ModelParams fold_parameters(const std::vector<FitParameter>& parameters, const LeastSquaresResult& fit,
+                            const Eigen::VectorXd& step, double t) {
   ModelParams out = fit.params;
-  for (int k = 0; k < p; ++k) {
+  for (int k = 0; k < static_cast<int>(step.size()); ++k) {
     const FitParameter& param = parameters[fit.active[k]];
-    double value = parameter_value(fit.params, param) + step[k] * fit.scale[k];
+    double value = parameter_value(fit.params, param) + t * step[k] * fit.scale[k];
     if (!std::isfinite(value)) value = parameter_value(fit.params, param);
     set_parameter_value(out, param, std::clamp(value, param.spec.lower, param.spec.upper));
   }
   return out;
 }
 
+// A session's sum of squares at `params`; infinity where the model finds no
+// equilibrium.
+double session_cost(const MeasuredSession& session, const ModelParams& params, const ReplayOptions& options) {
+  try {
+    return session_residuals(session, params, options).squaredNorm();
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
+  } catch (const std::exception&) {
+    return INFINITY;
+  }
+}
+
 }  // namespace
 
 CrossValidation cross_validate(const Dataset& dataset, const std::vector<FitParameter>& parameters,
-                               const LeastSquaresResult& fit, const ReplayOptions& options) {
+                               const LeastSquaresResult& fit, const ReplayOptions& options,
+                               const CrossValidationOptions& cv) {
   const int sessions = static_cast<int>(dataset.sessions.size());
   CrossValidation out;
   out.session_rmse_mm.assign(sessions, 0.0);
   out.fold_params.assign(sessions, fit.params);
+  out.fold_step.assign(sessions, 1.0);
   if (sessions < 2) {
     out.heldout_rmse_mm = fit.rmse_mm;
     return out;
   }
+  // Each session's cost at the optimum, replayed as the trials are: a fit's
+  // own residuals come from warm-started settles (or, for the screening,
+  // from a linearisation). Where that replay fails, every trial passes (the
+  // step is taken as it is).
+  const bool checked = cv.max_halvings >= 0 && !fit.active.empty();
+  std::vector<double> at_optimum(sessions, 0.0);
+  if (checked)
+    parallel_for(
+        sessions, [&](int s) { at_optimum[s] = session_cost(dataset.sessions[s], fit.params, options); },
+        options.threads);
   std::vector<double> sum_sq(sessions, 0.0);
   std::vector<long> count(sessions, 0);
   parallel_for(
       sessions,
       [&](int s) {
-        out.fold_params[s] = fold_parameters(parameters, fit, fit.session_rows[s], fit.session_rows[s + 1]);
+        const Eigen::VectorXd step = fold_step(fit, fit.session_rows[s], fit.session_rows[s + 1]);
+        out.fold_params[s] = fold_parameters(parameters, fit, step, 1.0);
+        if (checked) {
+          double optimum = 0.0;
+          for (int other = 0; other < sessions; ++other)
+            if (other != s) optimum += at_optimum[other];
+          out.fold_params[s] = fit.params;
+          out.fold_step[s] = 0.0;
+          double t = 1.0;
+          for (int h = 0; h <= cv.max_halvings; ++h, t *= 0.5) {
+            const ModelParams trial = fold_parameters(parameters, fit, step, t);
+            double cost = 0.0;
+            for (int other = 0; other < sessions && cost <= optimum; ++other)
+              if (other != s) cost += session_cost(dataset.sessions[other], trial, options);
+            if (cost <= optimum) {
+              out.fold_params[s] = trial;
+              out.fold_step[s] = t;
+              break;
+            }
+          }
+        }
         const Eigen::VectorXd r = session_residuals(dataset.sessions[s], out.fold_params[s], options);
         sum_sq[s] = r.squaredNorm();
         count[s] = r.size();
