@@ -1,9 +1,9 @@
 #include "calib/cross_validation.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 
+#include "calib/bounded_step.h"
 #include "calib/parallel_for.h"
 
 namespace hj {
@@ -11,22 +11,26 @@ namespace hj {
 namespace {
 
 // The fold's Gauss-Newton step from the optimum on the training rows, in
-// the fit's scaled variables (empty if nothing is free).
-Eigen::VectorXd fold_step(const LeastSquaresResult& fit, int rows_begin, int rows_end) {
+// the fit's scaled variables, each parameter kept inside its bounds (empty
+// if nothing is free).
+Eigen::VectorXd fold_step(const std::vector<FitParameter>& parameters, const LeastSquaresResult& fit, int rows_begin,
+                          int rows_end) {
   const int p = static_cast<int>(fit.active.size());
   if (p == 0) return {};
   const int n = static_cast<int>(fit.residuals.size());
-  Eigen::MatrixXd jtj = fit.jacobian.transpose() * fit.jacobian;
-  Eigen::VectorXd jtr = fit.jacobian.transpose() * fit.residuals;
-  const int held = rows_end - rows_begin;
-  if (held > 0 && held < n) {
-    const auto j_held = fit.jacobian.middleRows(rows_begin, held);
-    jtj -= j_held.transpose() * j_held;
-    jtr -= j_held.transpose() * fit.residuals.segment(rows_begin, held);
+  const int held = std::clamp(rows_end - rows_begin, 0, n);
+  Eigen::MatrixXd j(n - held, p);
+  Eigen::VectorXd r(n - held);
+  j << fit.jacobian.topRows(rows_begin), fit.jacobian.bottomRows(n - rows_begin - held);
+  r << fit.residuals.head(rows_begin), fit.residuals.tail(n - rows_begin - held);
+  Eigen::VectorXd lo(p), hi(p);
+  for (int k = 0; k < p; ++k) {
+    const FitParameter& param = parameters[fit.active[k]];
+    const double value = parameter_value(fit.params, param);
+    lo[k] = (param.spec.lower - value) / fit.scale[k];
+    hi[k] = (param.spec.upper - value) / fit.scale[k];
   }
-  // A little Levenberg damping keeps an exactly flat direction finite.
-  jtj.diagonal() *= 1.0 + 1e-6;
-  return -jtj.ldlt().solve(jtr);
+  return bounded_gauss_newton_step(j, r, lo, hi);
 }
 
 // The optimum moved by t * step, clamped to the bounds.
@@ -83,7 +87,7 @@ CrossValidation cross_validate(const Dataset& dataset, const std::vector<FitPara
   parallel_for(
       sessions,
       [&](int s) {
-        const Eigen::VectorXd step = fold_step(fit, fit.session_rows[s], fit.session_rows[s + 1]);
+        const Eigen::VectorXd step = fold_step(parameters, fit, fit.session_rows[s], fit.session_rows[s + 1]);
         out.fold_params[s] = fold_parameters(parameters, fit, step, 1.0);
         if (checked) {
           double optimum = 0.0;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "calib/bounded_step.h"
 #include "calib/parallel_for.h"
 
 namespace hj {
@@ -16,31 +17,6 @@ namespace {
 // As least_squares.cc scales its variables.
 double parameter_scale(const FitParameter& p, double start) {
   return std::max({std::abs(start), std::abs(p.spec.default_value), 1e-3 * (p.spec.upper - p.spec.lower), 1e-12});
-}
-
-// min |r + J d|^2 over d with the columns in `fixed` held at their given
-// step (fixed[k] finite), a little Levenberg damping as cross_validation.cc.
-Eigen::VectorXd gauss_newton_step(const Eigen::MatrixXd& j, const Eigen::VectorXd& r, const Eigen::VectorXd& fixed) {
-  const int p = static_cast<int>(j.cols());
-  Eigen::VectorXd step = Eigen::VectorXd::Zero(p);
-  std::vector<int> free;
-  Eigen::VectorXd rest = r;
-  for (int k = 0; k < p; ++k) {
-    if (std::isfinite(fixed[k])) {
-      step[k] = fixed[k];
-      rest += j.col(k) * fixed[k];
-    } else {
-      free.push_back(k);
-    }
-  }
-  if (free.empty()) return step;
-  Eigen::MatrixXd jf(j.rows(), free.size());
-  for (size_t k = 0; k < free.size(); ++k) jf.col(k) = j.col(free[k]);
-  Eigen::MatrixXd jtj = jf.transpose() * jf;
-  jtj.diagonal() *= 1.0 + 1e-6;
-  const Eigen::VectorXd d = -jtj.ldlt().solve(jf.transpose() * rest);
-  for (size_t k = 0; k < free.size(); ++k) step[free[k]] = std::isfinite(d[k]) ? d[k] : 0.0;
-  return step;
 }
 
 // Leave-one-session-out RMSE of the linearised model r(d) = r + J d at its
@@ -158,24 +134,18 @@ ScreeningPrediction screen_effect(const Dataset& dataset, const LeastSquaresResu
   for (size_t k = 0; k < kept.size(); ++k) j.col(p_base + k) = columns.col(kept[k]);
 
   // One Gauss-Newton step; an effect parameter that would leave its bounds
-  // is held at the bound and the others solved again.
-  Eigen::VectorXd fixed = Eigen::VectorXd::Constant(p, std::numeric_limits<double>::quiet_NaN());
-  Eigen::VectorXd d;
-  for (int pass = 0; pass <= static_cast<int>(kept.size()); ++pass) {
-    d = gauss_newton_step(j, r0, fixed);
-    bool clamped = false;
-    for (size_t k = 0; k < kept.size(); ++k) {
-      const int c = p_base + static_cast<int>(k);
-      if (std::isfinite(fixed[c])) continue;
-      const FitParameter& param = parameters[own[kept[k]]];
-      const double v = value[kept[k]] + d[c] * scale[kept[k]];
-      if (v < param.spec.lower || v > param.spec.upper) {
-        fixed[c] = (std::clamp(v, param.spec.lower, param.spec.upper) - value[kept[k]]) / scale[kept[k]];
-        clamped = true;
-      }
-    }
-    if (!clamped) break;
+  // is held at the bound and the others solved again. The current model's
+  // parameters are not held (a step that carries one past its bound is
+  // flagged below instead: holding them changed which candidates the
+  // held-out check kept on the synthetic matrix).
+  Eigen::VectorXd lo = Eigen::VectorXd::Constant(p, -std::numeric_limits<double>::infinity());
+  Eigen::VectorXd hi = Eigen::VectorXd::Constant(p, std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k < kept.size(); ++k) {
+    const FitParameter& param = parameters[own[kept[k]]];
+    lo[p_base + k] = (param.spec.lower - value[kept[k]]) / scale[kept[k]];
+    hi[p_base + k] = (param.spec.upper - value[kept[k]]) / scale[kept[k]];
   }
+  const Eigen::VectorXd d = bounded_gauss_newton_step(j, r0, lo, hi);
   const Eigen::VectorXd r1 = r0 + j * d;
 
   for (int k = 0; k < p_base; ++k) {
@@ -183,6 +153,11 @@ ScreeningPrediction screen_effect(const Dataset& dataset, const LeastSquaresResu
     const double v = parameter_value(start, param) + d[k] * current.scale[k];
     set_parameter_value(out.params, param, std::clamp(std::isfinite(v) ? v : parameter_value(start, param),
                                                       param.spec.lower, param.spec.upper));
+    // A current-model parameter the step takes from inside its bounds
+    // onto or past one.
+    const double from = parameter_value(start, param);
+    if ((v <= param.spec.lower && from > param.spec.lower) || (v >= param.spec.upper && from < param.spec.upper))
+      out.bounds_reached.push_back(param.qualified_name());
   }
   for (size_t k = 0; k < kept.size(); ++k) {
     const FitParameter& param = parameters[own[kept[k]]];
