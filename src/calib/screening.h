@@ -28,6 +28,10 @@ struct ScreeningPrediction {
   // that the linearisation's own error cancels.
   double reference_heldout_rmse_mm = 0.0;
   int replays = 0;               // whole-dataset replays it cost
+  // Current-model parameters the step carried from inside their bounds
+  // onto one: a step that long is beyond what the linearisation can
+  // predict, so the screening does not rule the candidate out on it.
+  std::vector<std::string> bounds_reached;
   // The linearisation itself, laid out as LeastSquaresResult's optimum
   // fields (residuals after the step, Jacobian, scale, active indices into
   // `parameters`), so that cross_validate() can check the held-out
