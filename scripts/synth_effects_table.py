@@ -11,6 +11,12 @@ import os
 import sys
 
 
+def bic_text(value):
+    """delta BIC as the table shows it; a candidate not refitted (outrun by a
+    refitted one, judged on its scan) has none (null in diagnosis.json)."""
+    return "n/a" if value is None else "%.0f" % value
+
+
 def load(path):
     try:
         with open(path) as f:
@@ -65,10 +71,10 @@ def row(work, case):
     ranking = []
     for c in diag["ranking"][:3]:
         mark = "*" if c["significant"] else ("s" if c.get("screened_out") else "")
-        ranking.append("%s %.0f%s" % (c["effect"], c["delta_bic"], mark))
+        ranking.append("%s %s%s" % (c["effect"], bic_text(c["delta_bic"]), mark))
     for c in diag.get("later_rounds", []):
         if c["significant"]:
-            ranking.append("then %s %.0f*" % (c["effect"], c["delta_bic"]))
+            ranking.append("then %s %s*" % (c["effect"], bic_text(c["delta_bic"])))
     fitted = []
     for e, n, v in truths:
         f, note = fitted_value(diag, e, n)
