@@ -10,7 +10,7 @@
 // to where the model no longer fits the training sessions either (synthetic
 // stiffening + cell_stiffness: the screening's folds predicted a held-out
 // 2.02 mm against the baseline's 1.60, where the refitted model's folds
-// give 1.34). Such a fold is not a refit of anything, so the step is halved
+// give 1.45). Such a fold is not a refit of anything, so the step is halved
 // until it does not raise the training cost, as a refit's line search
 // would, or dropped: the fold then keeps the full-data optimum.
 #pragma once
