@@ -30,16 +30,18 @@ constexpr const char* kDiagnoseUsage =
 
 // The stages grouped as the speed report asks: the baseline fit (levelling,
 // Algorithm 1, least squares), screening, candidate refits, cross-validation
-// (baseline and candidates), the residual pattern.
+// (baseline and candidates), the residual pattern; and the like-with-like
+// rechecks (calib/like_with_like.h).
 nlohmann::json time_split(const nlohmann::json& timing) {
   auto part_of = [](const std::string& stage) -> std::string {
+    if (stage.rfind("recheck ", 0) == 0 || stage.find("(refitted from ") != std::string::npos) return "rechecks";
     if (stage.rfind("screening ", 0) == 0 || stage.rfind("scan ", 0) == 0) return "screening";
     if (stage.rfind("candidate ", 0) == 0 || stage.rfind("converging baseline + ", 0) == 0) return "refits";
     if (stage == "cross-validation" || stage == "residual pattern") return stage;
     return "baseline fit";
   };
   nlohmann::json out = nlohmann::json::object();
-  for (const char* part : {"baseline fit", "cross-validation", "residual pattern", "screening", "refits"})
+  for (const char* part : {"baseline fit", "cross-validation", "residual pattern", "screening", "refits", "rechecks"})
     out[part] = {{"wall_s", 0.0}, {"cpu_s", 0.0}, {"replays", 0L}};
   for (const auto& t : timing) {
     nlohmann::json& part = out[part_of(t["stage"].get<std::string>())];

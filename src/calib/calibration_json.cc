@@ -20,6 +20,7 @@ nlohmann::json candidate_json(const CandidateFit& c) {
                       {"uncertainties", uncertainties_json(c.fit)}};
   if (c.screened_out) j["screening"] = c.screening_note;
   if (!c.scan_note.empty()) j["scan"] = c.scan_note;
+  if (!c.recheck_note.empty()) j["recheck"] = c.recheck_note;
   if (c.screened)
     j["predicted"] = {{"rmse_mm", c.predicted_rmse_mm},
                       {"heldout_rmse_mm", c.predicted_heldout_rmse_mm},

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "calib/like_with_like.h"
+
 namespace hj {
 
 namespace {
@@ -248,6 +250,73 @@ void outrun(CandidateFit& c, const LeastSquaresResult& current, double best_held
   c.screening_note = note;
 }
 
+// Best first: the significant ones, then by held-out RMSE.
+void rank(std::vector<CandidateFit>& fits) {
+  std::stable_sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
+    if (a.significant != b.significant) return a.significant;
+    return a.heldout_rmse_mm < b.heldout_rmse_mm;
+  });
+}
+
+// Replaces `current` (and its held-out RMSE, the ladder's last step, and
+// in round 0 the baseline) by the current model refitted from `c`'s
+// optimum with c's effect off, if that fits better (like_with_like.h); true
+// if it did. Says so in out.notes either way once it refits.
+bool recheck_current(const Dataset& dataset, const DiagnoseOptions& options, int round, const CandidateFit& c,
+                     const std::vector<std::string>& chosen, const DiagnoseProgress& progress, Diagnosis& out,
+                     LeastSquaresResult& current, double& current_heldout) {
+  std::string label = "baseline";
+  for (const auto& e : chosen) label += " + " + e;
+  const std::string stage = "recheck " + label + " from " + c.added + "'s optimum";
+  const auto parameters = fit_parameters(chosen);
+  if (progress) progress(stage, 0, options.fit.least_squares.max_iterations, "");
+  LikeWithLike check = refit_from_candidate_optimum(
+      dataset, current, parameters, c.fit.params, c.added, options.min_fit_gain, options.fit.least_squares,
+      [&](int iteration, int max_iterations, double rmse) {
+        if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
+      });
+  if (!check.refit) {
+    if (progress)
+      progress(stage, options.fit.least_squares.max_iterations, options.fit.least_squares.max_iterations,
+               "not needed");
+    return false;
+  }
+  LeastSquaresResult& refit = *check.refit;
+  converge(dataset, parameters, options, label + " (refitted from " + c.added + "'s optimum)", progress, refit,
+           out.notes);
+  char note[400];
+  const bool better = refit.sum_sq_mm2 < current.sum_sq_mm2;
+  std::snprintf(note, sizeof note,
+                "%s at %s's optimum with %s off replays at %.4f mm, below its own fit's %.4f mm: refitted from "
+                "there it reaches %.4f mm%s",
+                label.c_str(), c.added.c_str(), c.added.c_str(), check.stripped_rmse_mm, current.rmse_mm,
+                refit.rmse_mm, better ? ", and the candidates are judged against that fit" : ", no better: kept");
+  out.notes.push_back(note);
+  if (!better) return false;
+  current = std::move(refit);
+  if (progress) progress("cross-validation", 0, 1, label);
+  current_heldout = cross_validate(dataset, parameters, current, options.fit.least_squares.replay).heldout_rmse_mm;
+  if (progress) progress("cross-validation", 1, 1, label);
+  out.ladder.back().rmse_mm = current.rmse_mm;
+  out.ladder.back().heldout_rmse_mm = current_heldout;
+  if (round == 0) {
+    out.baseline.joint = current;
+    out.baseline_heldout_rmse_mm = current_heldout;
+  } else {
+    // The record of the candidate the current model is (chosen is its
+    // effects; no other candidate has exactly those).
+    for (auto* record : {&out.ranking, &out.later_rounds})
+      for (CandidateFit& chosen_fit : *record)
+        if (chosen_fit.effects == chosen) {
+          chosen_fit.delta_bic += bic(current) - bic(chosen_fit.fit);
+          chosen_fit.fit = current;
+          chosen_fit.heldout_rmse_mm = current_heldout;
+          chosen_fit.recheck_note = "refitted from " + c.added + "'s optimum with " + c.added + " off";
+        }
+  }
+  return true;
+}
+
 }  // namespace
 
 double bic(const LeastSquaresResult& fit) {
@@ -371,10 +440,28 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
         fits.push_back(std::move(c));
       }
     }
-    std::stable_sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
-      if (a.significant != b.significant) return a.significant;
-      return a.heldout_rmse_mm < b.heldout_rmse_mm;
-    });
+    rank(fits);
+    // Like with like (like_with_like.h): the best significant candidate's
+    // optimum with its effect switched off may fit better than the current
+    // model's own optimum; then the current model is refitted from there
+    // and every candidate judged against that. Each candidate once, and
+    // two refits at most a round.
+    std::vector<std::string> rechecked;
+    for (int refits = 0; refits < 2 && !fits.empty() && fits.front().significant;) {
+      const CandidateFit& best = fits.front();
+      if (std::find(rechecked.begin(), rechecked.end(), best.added) != rechecked.end()) break;
+      rechecked.push_back(best.added);
+      if (!recheck_current(dataset, options, round, best, chosen, progress, out, current, current_heldout)) break;
+      ++refits;
+      const std::string why = "not significant against the current model refitted from " + best.added + "'s optimum";
+      for (CandidateFit& c : fits)
+        if (c.significant) {
+          c.delta_bic = bic(c.fit) - bic(current);
+          c.significant = is_significant(c, current, current_heldout, options);
+          if (!c.significant) c.recheck_note = why;
+        }
+      rank(fits);
+    }
     const bool chosen_one = !fits.empty() && fits.front().significant;
     if (chosen_one) {
       // The next round is judged against this fit: it must have converged

@@ -81,6 +81,9 @@ struct CandidateFit {
   // Where the scan moved the start to, e.g. "bending.kappa_bend 0 -> 0.003
   // (sum of squares -54 %)"; empty if it kept the registry defaults.
   std::string scan_note;
+  // Set when the like-with-like recheck (like_with_like.h) changed this
+  // candidate's figures: refitted, or no longer significant.
+  std::string recheck_note;
   std::optional<ModelParams> scanned_start;
   // The RMSE at the scan's best point (or the start); NaN if not scanned.
   double scan_rmse_mm = std::numeric_limits<double>::quiet_NaN();

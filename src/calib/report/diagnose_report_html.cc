@@ -17,6 +17,7 @@ std::string num(double v, const char* format = "%.3f") { return format_number(v,
 std::string candidate_note(const CandidateFit& c) {
   std::string note = c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : "";
   if (!c.scan_note.empty()) note += (note.empty() ? "" : "; ") + std::string("started at ") + c.scan_note;
+  if (!c.recheck_note.empty()) note += (note.empty() ? "" : "; ") + c.recheck_note;
   return note;
 }
 
