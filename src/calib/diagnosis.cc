@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "calib/gain_by_capture.h"
 #include "calib/like_with_like.h"
 
 namespace hj {
@@ -317,6 +318,29 @@ bool recheck_current(const Dataset& dataset, const DiagnoseOptions& options, int
   return true;
 }
 
+// Says so in notes where most of a chosen effect's fall in the sum of
+// squares is in one capture (gain_by_capture.h): the user should look at
+// that capture before trusting the effect.
+void note_gain_in_one_capture(const Dataset& dataset, const LeastSquaresResult& current, const CandidateFit& best,
+                              std::vector<std::string>& notes) {
+  if (best.fit.residuals.size() != current.residuals.size() || current.residuals.size() == 0) return;
+  CaptureGain gain;
+  try {
+    gain = largest_capture_gain(dataset, current.residuals, best.fit.residuals);
+  } catch (const std::invalid_argument&) {
+    return;  // not laid out per capture: nothing to say
+  }
+  if (gain.capture < 0 || !(gain.share > 0.5) || dataset.capture_count() < 3) return;
+  char note[400];
+  std::snprintf(note, sizeof note,
+                "%s: %.0f %% of its fall in the sum of squares is in one capture, %s (RMSE %.3f -> %.3f mm); a gain "
+                "that rests on one capture may be the model's sensitivity there (near the levelling pressure, or a "
+                "jammed shape near a limit point) rather than the effect",
+                best.added.c_str(), 100.0 * std::min(gain.share, 1.0),
+                capture_name(dataset, gain.session, gain.capture).c_str(), gain.before_rmse_mm, gain.after_rmse_mm);
+  notes.push_back(note);
+}
+
 }  // namespace
 
 double bic(const LeastSquaresResult& fit) {
@@ -482,6 +506,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
         best.heldout_rmse_mm = cross_validate(dataset, best_parameters, best.fit, replay).heldout_rmse_mm;
         best.delta_bic = bic(best.fit) - bic(current);
       }
+      note_gain_in_one_capture(dataset, current, best, out.notes);
     }
     auto& record = round == 0 ? out.ranking : out.later_rounds;
     record.insert(record.end(), fits.begin(), fits.end());
