@@ -177,6 +177,7 @@ bool recheck_current(const Dataset& dataset, const DiagnoseOptions& options, int
   if (round == 0) {
     out.baseline.joint = current;
     out.baseline_heldout_rmse_mm = current_heldout;
+    out.pattern = describe_residuals(dataset, evaluate_dataset(dataset, current.params, options.fit.least_squares.replay));
   } else {
     // The record of the candidate the current model is (chosen is its
     // effects; no other candidate has exactly those).
@@ -360,12 +361,17 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
       if (!recheck_current(dataset, options, round, *next, chosen, progress, out, current, current_heldout)) continue;
       ++refits;
       const std::string why = "not significant against the current model refitted from " + next->added + "'s optimum";
-      for (CandidateFit& c : fits)
+      // Every refitted candidate's delta BIC is against the model it
+      // extends, so against this fit now; one that was not significant
+      // cannot become so against a better fit.
+      for (CandidateFit& c : fits) {
+        if (c.screened_out) continue;  // predicted figures: kept as predicted
+        c.delta_bic = bic(c.fit) - bic(current);
         if (c.significant) {
-          c.delta_bic = bic(c.fit) - bic(current);
           c.significant = is_significant(c, current, current_heldout, options);
           if (!c.significant) c.recheck_note = why;
         }
+      }
       rank(fits);
     }
     const bool chosen_one = !fits.empty() && fits.front().significant;
