@@ -13,8 +13,11 @@
 // two replays in a row cost more than the best before them. Points where
 // the model has no equilibrium (by default: that the static solver cannot
 // settle without the fallbacks) are stepped over; a start that does not
-// replay gives way to the best scanned point that does. The directions run
-// in parallel.
+// replay gives way to the best scanned point that does. The start is
+// replayed first; each point's settles then start from the states of the
+// last point of its direction that replayed (the start's at first). The
+// directions run in parallel (with fewer directions than threads, each
+// point's sessions too).
 #pragma once
 
 #include <string>

@@ -1,5 +1,7 @@
 #include "calib/residuals.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -178,19 +180,38 @@ Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelPar
   return out;
 }
 
-double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options) {
+double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
+                              const std::vector<ReplayTrace>* warm_start, std::vector<ReplayTrace>* traces,
+                              int session_threads) {
   ReplayOptions serial = options;
   serial.threads = 1;
-  double sum = 0.0;
-  for (const auto& session : dataset.sessions) {
-    try {
-      sum += session_residuals(session, params, serial).squaredNorm();
-    } catch (const SettleInterrupted&) {
-      throw;  // the caller stopped the work: not a failed replay
-    } catch (const std::exception&) {
-      return std::numeric_limits<double>::infinity();
-    }
+  const int n = static_cast<int>(dataset.sessions.size());
+  if (traces) traces->assign(n, ReplayTrace());
+  std::vector<double> sums(n, 0.0);
+  std::atomic<bool> failed{false};
+  parallel_for(
+      n,
+      [&](int s) {
+        if (failed) return;
+        const ReplayTrace* hint = warm_start && s < static_cast<int>(warm_start->size()) && !(*warm_start)[s].empty()
+                                      ? &(*warm_start)[s]
+                                      : nullptr;
+        try {
+          sums[s] = session_residuals(dataset.sessions[s], params, serial, hint, traces ? &(*traces)[s] : nullptr)
+                        .squaredNorm();
+        } catch (const SettleInterrupted&) {
+          throw;  // the caller stopped the work: not a failed replay
+        } catch (const std::exception&) {
+          failed = true;
+        }
+      },
+      std::max(1, session_threads));
+  if (failed) {
+    if (traces) traces->clear();
+    return std::numeric_limits<double>::infinity();
   }
+  double sum = 0.0;
+  for (double s : sums) sum += s;  // in session order, whatever the threads
   return sum;
 }
 
