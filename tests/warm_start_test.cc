@@ -23,20 +23,15 @@ struct AtEquilibrium {
   }
 };
 
-TEST(WarmStart, AJamAtEquilibriumKeepsTheStateWhateverTheStart) {
-  AtEquilibrium a;
-  const SettleReport& r = a.sim.apply(Action::jam(1, 1), a.start);
-  EXPECT_TRUE(r.converged);
-  EXPECT_EQ(r.iterations, 0);
-  EXPECT_EQ((a.sim.state().x - a.before).cwiseAbs().maxCoeff(), 0.0);
-}
-
-TEST(WarmStart, APinAtEquilibriumKeepsTheStateWhateverTheStart) {
-  AtEquilibrium a;
-  const SettleReport& r = a.sim.apply(Action::pin(1, 1), a.start);
-  EXPECT_TRUE(r.converged);
-  EXPECT_EQ(r.iterations, 0);
-  EXPECT_EQ((a.sim.state().x - a.before).cwiseAbs().maxCoeff(), 0.0);
+TEST(WarmStart, AJamOrPinAtEquilibriumKeepsTheStateWhateverTheStart) {
+  for (const Action& action : {Action::jam(1, 1), Action::pin(1, 1)}) {
+    SCOPED_TRACE(action.describe());
+    AtEquilibrium a;
+    const SettleReport& r = a.sim.apply(action, a.start);
+    EXPECT_TRUE(r.converged);
+    EXPECT_EQ(r.iterations, 0);
+    EXPECT_EQ((a.sim.state().x - a.before).cwiseAbs().maxCoeff(), 0.0);
+  }
 }
 
 // The pressure step after it does use the start, and reaches the
