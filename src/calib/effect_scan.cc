@@ -24,13 +24,12 @@ struct DirectionResult {
   int replays = 0, failed = 0;
 };
 
-// Each point's settles start from the states of the last point that
-// replayed (at first the start's): the points are near each other, and a
-// warm start settles the jammed sessions in a fraction of the Newton steps
-// of a cold one.
+// Every point is replayed cold. Not from the last point's states: the
+// points are 3 x apart, and on demo-baseline's bending scan a replay
+// warm-started from the point before took 17-53 s against 8-10 s cold
+// (settles crawling from a far start) and reached other equilibria.
 DirectionResult walk(const Dataset& dataset, const ModelParams& start, const Direction& d,
-                     ReplayOptions replay, const EffectScanOptions& options, std::vector<ReplayTrace> last,
-                     int session_threads) {
+                     ReplayOptions replay, const EffectScanOptions& options, int session_threads) {
   // A point is only a candidate start, so one the static solver cannot
   // settle is stepped over at once rather than after the fallbacks (a
   // failed replay with them: about 5 s at 3 x 4; most of a scan's time
@@ -42,14 +41,12 @@ DirectionResult walk(const Dataset& dataset, const ModelParams& start, const Dir
     const double value = d.from + fraction * (d.to - d.from);
     ModelParams point = start;
     set_parameter_value(point, d.parameter, value);
-    std::vector<ReplayTrace> traces;
-    const double sum_sq = dataset_sum_of_squares(dataset, point, replay, &last, &traces, session_threads);
+    const double sum_sq = dataset_sum_of_squares(dataset, point, replay, session_threads);
     ++out.replays;
     if (!std::isfinite(sum_sq)) {
       ++out.failed;  // no equilibrium here: step over it
       continue;
     }
-    last = std::move(traces);
     if (sum_sq < out.best_sum_sq) {
       out.best_sum_sq = sum_sq;
       out.value = value;
@@ -76,19 +73,17 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
     if (v < p.spec.upper) directions.push_back({p, v, p.spec.upper});
   }
   std::vector<DirectionResult> results(directions.size() + 1);
-  // Result 0 is the start itself, replayed first on every thread: its
-  // settled states are where each direction's first point starts.
+  // Result 0 is the start itself, replayed first on every thread; then the
+  // directions in parallel, and with fewer directions than threads each
+  // point's sessions too (a one-parameter effect at its bound has a single
+  // direction, which would otherwise run on one core).
   const int threads = replay.threads > 0 ? replay.threads : default_thread_count();
-  std::vector<ReplayTrace> start_traces;
-  results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, nullptr, &start_traces, threads);
+  results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, threads);
   results[0].replays = 1;
-  // Fewer directions than threads: the rest replay each point's sessions.
   const int session_threads = std::max(1, threads / std::max(1, static_cast<int>(directions.size())));
   parallel_for(
       static_cast<int>(directions.size()),
-      [&](int k) {
-        results[k + 1] = walk(dataset, start, directions[k], replay, options, start_traces, session_threads);
-      },
+      [&](int k) { results[k + 1] = walk(dataset, start, directions[k], replay, options, session_threads); },
       replay.threads);
   for (const auto& r : results) {
     out.replays += r.replays;

@@ -13,11 +13,9 @@
 // two replays in a row cost more than the best before them. Points where
 // the model has no equilibrium (by default: that the static solver cannot
 // settle without the fallbacks) are stepped over; a start that does not
-// replay gives way to the best scanned point that does. The start is
-// replayed first; each point's settles then start from the states of the
-// last point of its direction that replayed (the start's at first). The
-// directions run in parallel (with fewer directions than threads, each
-// point's sessions too).
+// replay gives way to the best scanned point that does. Every point is
+// replayed cold (effect_scan.cc says why). The directions run in parallel
+// (with fewer directions than threads, each point's sessions too).
 #pragma once
 
 #include <string>

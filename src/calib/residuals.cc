@@ -181,24 +181,18 @@ Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelPar
 }
 
 double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                              const std::vector<ReplayTrace>* warm_start, std::vector<ReplayTrace>* traces,
                               int session_threads) {
   ReplayOptions serial = options;
   serial.threads = 1;
   const int n = static_cast<int>(dataset.sessions.size());
-  if (traces) traces->assign(n, ReplayTrace());
   std::vector<double> sums(n, 0.0);
   std::atomic<bool> failed{false};
   parallel_for(
       n,
       [&](int s) {
         if (failed) return;
-        const ReplayTrace* hint = warm_start && s < static_cast<int>(warm_start->size()) && !(*warm_start)[s].empty()
-                                      ? &(*warm_start)[s]
-                                      : nullptr;
         try {
-          sums[s] = session_residuals(dataset.sessions[s], params, serial, hint, traces ? &(*traces)[s] : nullptr)
-                        .squaredNorm();
+          sums[s] = session_residuals(dataset.sessions[s], params, serial).squaredNorm();
         } catch (const SettleInterrupted&) {
           throw;  // the caller stopped the work: not a failed replay
         } catch (const std::exception&) {
@@ -206,10 +200,7 @@ double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params,
         }
       },
       std::max(1, session_threads));
-  if (failed) {
-    if (traces) traces->clear();
-    return std::numeric_limits<double>::infinity();
-  }
+  if (failed) return std::numeric_limits<double>::infinity();
   double sum = 0.0;
   for (double s : sums) sum += s;  // in session order, whatever the threads
   return sum;

@@ -119,13 +119,9 @@ int residual_count(const MeasuredSession& session);
 // replayed one after another (for callers that run several points in
 // parallel: effect_scan.h, optimum_probe.h); infinity where a session has
 // no equilibrium. SettleInterrupted is let through.
-// With warm_start (one trace per session, or empty ones), each session's
-// settles start from its trace's states (session_residuals); with traces,
-// this replay's are recorded there (cleared if a session fails). With
-// session_threads > 1 the sessions run on that many threads, for a caller
-// with fewer points than cores.
+// With session_threads > 1 the sessions run on that many threads, for a
+// caller with fewer points than cores.
 double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                              const std::vector<ReplayTrace>* warm_start = nullptr,
-                              std::vector<ReplayTrace>* traces = nullptr, int session_threads = 1);
+                              int session_threads = 1);
 
 }  // namespace hj
