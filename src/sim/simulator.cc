@@ -151,7 +151,7 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
   // Such an action settles from the state as it is, not from a warm start:
   // that is an equilibrium already, while the start was settled under other
   // parameters and takes a full settle (jammed-sweep of demo-bending under a
-  // mass 0.01 % off: 8 Newton steps at each of its 12 jams).
+  // mass 0.01 % off: 7-8 Newton steps at each of its 12 jams).
   if (keeps_equilibrium_) start = nullptr;
   try {
     if (start) {
