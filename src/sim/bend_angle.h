@@ -31,13 +31,15 @@ inline double bend_angle(const Eigen::Vector3d& xa, const Eigen::Vector3d& xi, c
   return std::atan2(v1 * u2 - u1 * v2, u1 * u2 + v1 * v2);
 }
 
-// d phi / d x_p for the five points, in BendPoint order. Templated so that
-// forward-mode automatic differentiation of it gives the exact Hessian.
+// d phi / d (e1, e2, c), the three edge vectors phi depends on (d = e1 +
+// e2): it is a function of 9 numbers, not of the 15 point coordinates, so
+// differentiating this one (forward-mode automatic differentiation, for the
+// exact Hessian) costs 9 derivative lanes rather than 15.
 template <class T>
-std::array<Vec3<T>, 5> bend_angle_gradient(const Vec3<T>& xa, const Vec3<T>& xi, const Vec3<T>& xb,
-                                           const Vec3<T>& xc1, const Vec3<T>& xc2, double sigma) {
+std::array<Vec3<T>, 3> bend_angle_edge_gradient(const Vec3<T>& e1, const Vec3<T>& e2, const Vec3<T>& c,
+                                                double sigma) {
   using std::sqrt;
-  const Vec3<T> d = xb - xa, c = xc2 - xc1, e1 = xi - xa, e2 = xb - xi;
+  const Vec3<T> d = e1 + e2;
   const Vec3<T> w = d.cross(c) * T(sigma);
   const T w_len = sqrt(w.squaredNorm()), d_len = sqrt(d.squaredNorm());
   const Vec3<T> n = w / w_len, t = d / d_len;
@@ -54,8 +56,17 @@ std::array<Vec3<T>, 5> bend_angle_gradient(const Vec3<T>& xa, const Vec3<T>& xi,
   const Vec3<T> da2_dd = (c.cross(g2) * T(sigma) * u2 - du2_dd * v2) / r2;
   const Vec3<T> g_d = da1_dd - da2_dd;
   const Vec3<T> g_c = (g1.cross(d) * (u1 / r1) - g2.cross(d) * (u2 / r2)) * T(sigma);
-  // phi = alpha_1 - alpha_2 with e1 = x_i - x_A, e2 = x_B - x_i, d = x_B - x_A, c = x_C2 - x_C1.
-  return {-g_e1 - g_d, g_e1 + g_e2, g_d - g_e2, -g_c, g_c};
+  // phi = alpha_1 - alpha_2, and d = e1 + e2 moves with both.
+  return {g_e1 + g_d, g_d - g_e2, g_c};
+}
+
+// d phi / d x_p for the five points, in BendPoint order: e1 = x_i - x_A,
+// e2 = x_B - x_i, c = x_C2 - x_C1.
+template <class T>
+std::array<Vec3<T>, 5> bend_angle_gradient(const Vec3<T>& xa, const Vec3<T>& xi, const Vec3<T>& xb,
+                                           const Vec3<T>& xc1, const Vec3<T>& xc2, double sigma) {
+  const auto g = bend_angle_edge_gradient<T>(xi - xa, xb - xi, xc2 - xc1, sigma);
+  return {-g[0], g[0] - g[1], g[1], -g[2], g[2]};
 }
 
 }  // namespace hj
