@@ -31,6 +31,10 @@ StiffnessMatrix::StiffnessMatrix(const Mesh& mesh, const std::vector<char>& fixe
                                  const std::function<void(StiffnessSink&)>& touch)
     : point_cols_(mesh.point_cols()), dof_of_point_(mesh.num_points(), -1) {
   int n = 0;
+  for (int p = 0; p < mesh.num_points(); ++p) {
+    row_of_point_.push_back(p / point_cols_);
+    col_of_point_.push_back(p % point_cols_);
+  }
   for (int p = 0; p < mesh.num_points(); ++p)
     if (!fixed[p]) {
       dof_of_point_[p] = n;
@@ -63,23 +67,23 @@ StiffnessMatrix::StiffnessMatrix(const Mesh& mesh, const std::vector<char>& fixe
   matrix_.resize(n, n);
   matrix_.setFromTriplets(triplets.begin(), triplets.end());
   matrix_.makeCompressed();
-  value_index_.assign(static_cast<size_t>(mesh.num_points()) * kStencil * kStencil * 9, -1);
+  value_index_.assign(static_cast<size_t>(mesh.num_points()) * kStencil * kStencil * 3, -1);
   for_each_pair([&](int p, int q) {
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) {
-        const int row = dof_of_point_[p] + r, col = dof_of_point_[q] + c;
-        const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
-        const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
-        const int* hit = std::lower_bound(begin, end, row);
-        value_index_[(static_cast<size_t>(p) * 25 + slot(p, q)) * 9 + 3 * r + c] =
-            static_cast<int>(hit - matrix_.innerIndexPtr());
-      }
+    for (int c = 0; c < 3; ++c) {
+      const int row = dof_of_point_[p], col = dof_of_point_[q] + c;
+      const int* begin = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col];
+      const int* end = matrix_.innerIndexPtr() + matrix_.outerIndexPtr()[col + 1];
+      const int* hit = std::lower_bound(begin, end, row);
+      if (end - hit < 3 || hit[1] != row + 1 || hit[2] != row + 2)
+        throw std::logic_error("the stiffness pattern is not made of whole 3 x 3 blocks");
+      value_index_[(static_cast<size_t>(p) * 25 + slot(p, q)) * 3 + c] = static_cast<int>(hit - matrix_.innerIndexPtr());
+    }
   });
 }
 
 int StiffnessMatrix::slot(int row_point, int col_point) const {
-  const int di = col_point / point_cols_ - row_point / point_cols_;
-  const int dj = col_point % point_cols_ - row_point % point_cols_;
+  const int di = row_of_point_[col_point] - row_of_point_[row_point];
+  const int dj = col_of_point_[col_point] - col_of_point_[row_point];
   assert(std::abs(di) + std::abs(dj) <= 2);
   return (di + 2) * kStencil + (dj + 2);
 }
@@ -90,11 +94,11 @@ void StiffnessMatrix::set_zero() {
 
 void StiffnessMatrix::add(int row_point, int col_point, const Eigen::Matrix3d& block) {
   if (dof_of_point_[row_point] < 0 || dof_of_point_[col_point] < 0) return;
-  const int* idx = &value_index_[(static_cast<size_t>(row_point) * 25 + slot(row_point, col_point)) * 9];
+  const int* idx = &value_index_[(static_cast<size_t>(row_point) * 25 + slot(row_point, col_point)) * 3];
   if (idx[0] < 0) throw std::logic_error("a stiffness block outside the pattern recorded for this settle");
   double* values = matrix_.valuePtr();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) values[idx[3 * r + c]] += block(r, c);
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) values[idx[c] + r] += block(r, c);
 }
 
 Eigen::VectorXd StiffnessMatrix::gather(const Eigen::Matrix3Xd& field) const {

@@ -38,10 +38,16 @@ class StiffnessMatrix final : public StiffnessSink {
   int slot(int row_point, int col_point) const;
 
   int point_cols_;
+  // Each point's mesh row and column, so that slot() needs no division (it
+  // runs 25 times per bending spring in every Newton step).
+  std::vector<int> row_of_point_, col_of_point_;
   std::vector<int> dof_of_point_;
   std::vector<int> free_points_;
-  // value_index_[(row_point * 25 + slot) * 9 + 3 * r + c]: position in
-  // matrix_.valuePtr(), -1 where the row or column point is fixed.
+  // value_index_[(row_point * 25 + slot) * 3 + c]: position in
+  // matrix_.valuePtr() of the block's column c, row 0 (rows 1 and 2 follow:
+  // the pattern is made of whole 3 x 3 blocks); -1 where the row or column
+  // point is fixed. One index per column, not per entry, keeps the table
+  // small enough to stay in cache while a step's stiffness is added.
   std::vector<int> value_index_;
   Eigen::SparseMatrix<double> matrix_;
 };
