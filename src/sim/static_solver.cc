@@ -106,6 +106,11 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
   // The residual norm when it last halved, and that iteration (stall_iterations).
   double halved_norm = start_norm;
   int halved_at = 0;
+  // K at state.x before the shift, kept for the steps after a refused one
+  // (the careful control refuses about a third of its steps on stiff jammed
+  // cells): only the shift changes there, so K is not assembled again.
+  Eigen::VectorXd unshifted;
+  bool unshifted_current = false;
   // A push that has not led to another equilibrium within its budget was
   // along a mode too weak to matter: settle for the equilibrium it left.
   auto settle_for_pushed_from = [&] {
@@ -148,6 +153,7 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       pushed_mode = mode;
       pushed_at = it;
       state.x += (0.05 * mesh.spacing() / largest) * push;
+      unshifted_current = false;
       model.forces(state, state.x, f);
       residual = k.gather(f);
       mu = mu0;
@@ -162,8 +168,14 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
     } else if (control != StepControl::kDisplacement && pushed_at < 0 && it - halved_at > options.stall_iterations) {
       break;  // stalled: nothing to converge to
     }
-    k.set_zero();
-    model.add_stiffness(state, state.x, k);
+    if (unshifted_current) {
+      k.matrix().coeffs() = unshifted;
+    } else {
+      k.set_zero();
+      model.add_stiffness(state, state.x, k);
+      unshifted = k.matrix().coeffs();
+      unshifted_current = true;
+    }
     add_shift(k, mu);
     Eigen::VectorXd full_step;
     const double largest = solver.solve(k.matrix(), mu, residual, full_step)
@@ -235,6 +247,7 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
         mu *= 0.7;
     }
     state.x = x_trial;
+    unshifted_current = false;
     f.swap(f_trial);
     residual = residual_trial;
     if (mu < 1e-10 * mu0) mu = 0.0;
