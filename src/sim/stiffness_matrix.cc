@@ -32,8 +32,8 @@ StiffnessMatrix::StiffnessMatrix(const Mesh& mesh, const std::vector<char>& fixe
     : point_cols_(mesh.point_cols()), dof_of_point_(mesh.num_points(), -1) {
   int n = 0;
   for (int p = 0; p < mesh.num_points(); ++p) {
-    row_of_point_.push_back(p / point_cols_);
-    col_of_point_.push_back(p % point_cols_);
+    row_of_point_.push_back(mesh.row_of(p));
+    col_of_point_.push_back(mesh.col_of(p));
   }
   for (int p = 0; p < mesh.num_points(); ++p)
     if (!fixed[p]) {
