@@ -3,6 +3,8 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/UmfPackSupport>
 
+#include "sim/band_lu.h"
+
 namespace hj {
 
 namespace {
@@ -19,8 +21,10 @@ constexpr double kTolerance = 1e-8;
 }  // namespace
 
 struct ShiftedSolver::Direct {
-  Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu;
+  BandLU band;                                       // small systems (band_lu.h)
+  Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu;  // the rest
   bool analysed = false;
+  bool use_band = false;
 };
 
 ShiftedSolver::ShiftedSolver() : direct_(std::make_unique<Direct>()) {
@@ -46,12 +50,19 @@ bool ShiftedSolver::solve(const Eigen::SparseMatrix<double>& a, double mu, const
     failed_mu_ = mu;
   }
   if (!direct_->analysed) {
-    direct_->lu.analyzePattern(a);
+    direct_->band.analyze(a);
+    direct_->use_band = direct_->band.worthwhile();
+    if (!direct_->use_band) direct_->lu.analyzePattern(a);
     direct_->analysed = true;
   }
-  direct_->lu.factorize(a);
-  if (direct_->lu.info() != Eigen::Success) return false;
-  dx = direct_->lu.solve(r);
+  if (direct_->use_band) {
+    if (!direct_->band.factorize(a)) return false;
+    direct_->band.solve(r, dx);
+  } else {
+    direct_->lu.factorize(a);
+    if (direct_->lu.info() != Eigen::Success) return false;
+    dx = direct_->lu.solve(r);
+  }
   ++direct_solves_;
   last_direct_ = true;
   return dx.allFinite();
@@ -60,7 +71,10 @@ bool ShiftedSolver::solve(const Eigen::SparseMatrix<double>& a, double mu, const
 bool ShiftedSolver::solve_again(const Eigen::SparseMatrix<double>& a, double mu, const Eigen::VectorXd& r,
                                 Eigen::VectorXd& dx) {
   if (!last_direct_) return solve(a, mu, r, dx);  // iterations are cheap
-  dx = direct_->lu.solve(r);
+  if (direct_->use_band)
+    direct_->band.solve(r, dx);
+  else
+    dx = direct_->lu.solve(r);
   return dx.allFinite();
 }
 

@@ -3,8 +3,9 @@
 // shifted matrix is diagonally dominant and Jacobi-preconditioned BiCGSTAB
 // converges in a few dozen products, an order of magnitude cheaper than a
 // sparse LU on a 9 x 12 array; as mu falls towards Newton it stops
-// converging within its budget and the solve switches to UMFPACK's LU
-// (factorised only when needed).
+// converging within its budget and the solve switches to a direct LU
+// (factorised only when needed): the band LU on small arrays (band_lu.h),
+// UMFPACK's otherwise.
 #pragma once
 
 #include <Eigen/SparseCore>
