@@ -66,6 +66,35 @@ TEST(OptimumProbe, FindsTheBasinAConvergedFitSitsBeside) {
   EXPECT_NE(probe.note.find("mass_kg 0.519771 -> 0.5201"), std::string::npos) << probe.note;
 }
 
+// A loose parameter: `hapticjam fit demo-baseline` converged at kappa_jam
+// 11.46 +- 8.0 (bounds 0 .. 100), where 10, 30 and 100 standard errors all
+// land on a bound. The probe looks between the optimum and the bounds
+// instead, and finds the truth's side (4.2).
+TEST(OptimumProbe, LooksBetweenALooseParameterAndItsBounds) {
+  const Dataset d = select_sessions(read_dataset(kSessions / "demo-baseline"), {"jammed-sweep"}, true);
+  ReplayOptions replay = fitting_replay({});
+  replay.threads = 2;
+  FitParameter kappa_jam;
+  for (const auto& p : fit_parameters({}))
+    if (p.spec.name == "kappa_jam") kappa_jam = p;
+  LeastSquaresResult fit;
+  fit.params = truth();
+  fit.params.surface.mass_kg = 0.5200213;
+  fit.params.surface.spring_k = 57.965721;
+  fit.params.surface.kappa_jam = 11.4635;
+  fit.estimates.push_back({kappa_jam, 11.4635, 8.0, 11.4635 - 15.7, 11.4635 + 15.7});
+  fit.sum_sq_mm2 = dataset_sum_of_squares(d, fit.params, replay);
+  fit.converged = true;
+
+  const OptimumProbe probe = probe_optimum(d, fit, replay);
+  // Down: 1/4, 1/2 and 3/4 of the way to 0. Up: 10 standard errors (91.46),
+  // then 1/4, 1/2 and 3/4 of the way to 100.
+  EXPECT_EQ(probe.points, 7);
+  EXPECT_TRUE(probe.moved) << "start " << fit.sum_sq_mm2 << ", best " << probe.best_sum_sq_mm2 << " mm^2";
+  EXPECT_LT(probe.best.surface.kappa_jam, 6.0) << probe.note;
+  EXPECT_GT(probe.best.surface.kappa_jam, 2.0) << probe.note;
+}
+
 TEST(OptimumProbe, StaysAtAnOptimumWithNothingBetterNearby) {
   const Dataset d = select_sessions(read_dataset(kSessions / "demo-baseline"), {"jammed-sweep"}, true);
   LeastSquaresOptions options;

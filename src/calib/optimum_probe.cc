@@ -18,11 +18,22 @@ OptimumProbe probe_optimum(const Dataset& dataset, const LeastSquaresResult& fit
   std::vector<Point> points;
   for (const ParameterEstimate& e : fit.estimates) {
     if (!e.active || !(e.std_error > 0.0) || !std::isfinite(e.std_error)) continue;
-    for (double m : options.multiples)
-      for (double sign : {1.0, -1.0}) {
-        const double v = std::clamp(e.value + sign * m * e.std_error, e.parameter.spec.lower, e.parameter.spec.upper);
-        if (v != e.value) points.push_back({&e, v});
+    for (double sign : {1.0, -1.0}) {
+      const double bound = sign > 0.0 ? e.parameter.spec.upper : e.parameter.spec.lower;
+      const double room = std::abs(bound - e.value);
+      if (!(room > 0.0)) continue;
+      bool past_bound = false;
+      for (double m : options.multiples) {
+        if (m * e.std_error < room)
+          points.push_back({&e, e.value + sign * m * e.std_error});
+        else
+          past_bound = true;
       }
+      // A loose parameter's multiples all land on the bound: the probe
+      // looks between the optimum and the bound instead.
+      if (past_bound)
+        for (double f : options.bound_fractions) points.push_back({&e, e.value + sign * f * room});
+    }
   }
   OptimumProbe out;
   out.best = fit.params;

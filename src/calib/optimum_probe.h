@@ -9,8 +9,9 @@
 // the truth 18 standard errors away at RMSE 1.042.
 //
 // Each free parameter is moved alone by a few multiples of its standard
-// error each way (10, 30 and 100 by default) and the dataset replayed
-// there, all points in parallel; if the best point lowers the sum of
+// error each way (10, 30 and 100 by default; where that passes a bound, to
+// points between the optimum and the bound instead) and the dataset
+// replayed there, all points in parallel; if the best point lowers the sum of
 // squares by a real margin, the fit should start again from it.
 #pragma once
 
@@ -23,6 +24,12 @@ namespace hj {
 
 struct OptimumProbeOptions {
   std::vector<double> multiples = {10.0, 30.0, 100.0};  // of the standard error
+  // Where a multiple would pass the parameter's bound, these fractions of
+  // the way to it instead. demo-baseline's fit converged at kappa_jam 11.46
+  // with a standard error of 8 (bounds 0 .. 100): every multiple probed 0
+  // or 100, and the basin near the truth, 4.2 (RMSE 1.0428 at 3.6 against
+  // the fit's 1.0460), was never looked at.
+  std::vector<double> bound_fractions = {0.25, 0.5, 0.75};
   // A point is taken only if it lowers the sum of squares by this share.
   double min_gain = 0.002;
 };
