@@ -80,8 +80,11 @@ struct ProfileOptions {
   double relative_tolerance = 0.05;  // of the linearised half-width
 };
 
-// Replaces the linearised 95 % interval of each loose, active parameter of
-// `fit` (the result of fit_least_squares on `dataset` with `parameters`) by
+// Replaces the linearised 95 % interval of each active parameter of `fit`
+// (the result of fit_least_squares on `dataset` with `parameters`) that is
+// loose, or at whose linearised ends the cost, the others held, rises by
+// less than half the threshold (the model is not linear there, e.g. next to
+// a jump; two replays a parameter), by
 // its profile interval (search: profile_interval from the linearised
 // half-width; the others refitted at each point by chord steps with the
 // fit's Jacobian, warm-started), sets interval_method to "profile likelihood" and
