@@ -61,8 +61,40 @@ void Simulator::settle_once(bool fallbacks) {
     }
   }
   const Eigen::Matrix3Xd before = state_.x;
+  SettleReport tried;  // what the fast control and the flow spent first
+  if (fallbacks && options_.flow_fallback && options_.flow_first && options_.static_options.fast_iterations > 0) {
+    if (settle_fast_then_flow(before)) return;
+    tried = last_;
+  }
   last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
   if (!last_.converged && fallbacks) settle_fallbacks(before);
+  last_.iterations += tried.iterations;
+  last_.seconds += tried.seconds;
+}
+
+bool Simulator::settle_fast_then_flow(const Eigen::Matrix3Xd& before) {
+  StaticSolverOptions fast_only = options_.static_options;
+  fast_only.careful = false;
+  last_ = settle_static(model_, state_, fast_only, &settle_memory_);
+  if (last_.converged) return true;
+  SettleReport spent = last_;
+  state_.x = before;
+  const SettleReport flow = settle_implicit_flow(model_, state_, options_.flow_options);
+  spent.iterations += flow.iterations;
+  spent.seconds += flow.seconds;
+  if (flow.converged) {
+    last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
+    last_.iterations += spent.iterations;
+    last_.seconds += spent.seconds;
+    if (last_.converged) return true;
+    spent = last_;
+  }
+  // Neither: the careful controls from the start, as without this.
+  state_.x = before;
+  last_ = SettleReport{};
+  last_.iterations = spent.iterations;
+  last_.seconds = spent.seconds;
+  return false;
 }
 
 void Simulator::settle_fallbacks(const Eigen::Matrix3Xd& before) {

@@ -286,6 +286,10 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
       report.restarts = 0;
     }
   }
+  if (!report.converged && !options.careful) {
+    report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return report;
+  }
   if (!report.converged)
     run_continuation(model, state, k, solver, fixed, options, StepControl::kModelTrust, options.max_iterations, mu0,
                      remembered, report);

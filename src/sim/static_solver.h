@@ -47,6 +47,9 @@ struct StaticSolverOptions {
   // the ones that failed, 176 of 207 never halved in their last 900.
   int stall_iterations = 500;
   bool check_stability = true;
+  // false: give up when the fast control does not settle, without the
+  // careful ones (the simulator then tries the implicit flow first).
+  bool careful = true;
   // Polled every step; true throws SettleInterrupted (state left mid-way).
   std::function<bool()> interrupted;
 
