@@ -207,7 +207,6 @@ class ChordRefit {
   std::vector<ReplayTrace> traces_[2];
 };
 
-
 // A linearised interval is believed only where the cost, the other
 // parameters held, rises at both its ends by at least half the profile's
 // threshold: for a model linear in its parameters it rises there by at
