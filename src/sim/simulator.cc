@@ -79,16 +79,7 @@ bool Simulator::settle_fast_then_flow(const Eigen::Matrix3Xd& before) {
   if (last_.converged) return true;
   SettleReport spent = last_;
   state_.x = before;
-  const SettleReport flow = settle_implicit_flow(model_, state_, options_.flow_options);
-  spent.iterations += flow.iterations;
-  spent.seconds += flow.seconds;
-  if (flow.converged) {
-    last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
-    last_.iterations += spent.iterations;
-    last_.seconds += spent.seconds;
-    if (last_.converged) return true;
-    spent = last_;
-  }
+  if (flow_then_polish(1, spent)) return true;
   // Neither: the careful controls from the start, as without this.
   state_.x = before;
   last_ = SettleReport{};
@@ -97,32 +88,35 @@ bool Simulator::settle_fast_then_flow(const Eigen::Matrix3Xd& before) {
   return false;
 }
 
+bool Simulator::polish(const SettleReport& fallback, SettleReport& spent) {
+  spent.iterations += fallback.iterations;
+  spent.seconds += fallback.seconds;
+  last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
+  last_.iterations += spent.iterations;
+  last_.seconds += spent.seconds;
+  last_.restarts += spent.restarts;
+  spent = last_;
+  return last_.converged;
+}
+
+bool Simulator::flow_then_polish(int rounds, SettleReport& spent) {
+  for (int round = 0; round < rounds; ++round) {
+    const SettleReport flow = settle_implicit_flow(model_, state_, options_.flow_options);
+    if (!flow.converged) {
+      spent.iterations += flow.iterations;
+      spent.seconds += flow.seconds;
+      return false;
+    }
+    if (polish(flow, spent)) return true;
+  }
+  return false;
+}
+
 void Simulator::settle_fallbacks(const Eigen::Matrix3Xd& before) {
   SettleReport spent = last_;
-  const auto polish = [&](const SettleReport& fallback) {
-    spent.iterations += fallback.iterations;
-    spent.seconds += fallback.seconds;
-    last_ = settle_static(model_, state_, options_.static_options, &settle_memory_);
-    last_.iterations += spent.iterations;
-    last_.seconds += spent.seconds;
-    last_.restarts += spent.restarts;
-    spent = last_;
-    return last_.converged;
-  };
   if (options_.flow_fallback) {
     state_.x = before;
-    // A polish that pushes off a saddle and does not settle again leaves the
-    // state beside it: flow on from there.
-    constexpr int kRounds = 3;
-    for (int round = 0; round < kRounds; ++round) {
-      const SettleReport flow = settle_implicit_flow(model_, state_, options_.flow_options);
-      if (!flow.converged) {
-        spent.iterations += flow.iterations;
-        spent.seconds += flow.seconds;
-        break;
-      }
-      if (polish(flow)) return;
-    }
+    if (flow_then_polish(3, spent)) return;
   }
   if (options_.fallback_max_steps == 0) {
     last_ = spent;
@@ -133,7 +127,7 @@ void Simulator::settle_fallbacks(const Eigen::Matrix3Xd& before) {
   state_.x = before;
   ExplicitEulerOptions fallback = options_.explicit_options;
   fallback.max_steps = std::min(fallback.max_steps, options_.fallback_max_steps);
-  polish(settle_explicit(model_, state_, fallback));
+  polish(settle_explicit(model_, state_, fallback), spent);
 }
 
 const SettleReport& Simulator::apply(const Action& action) { return apply_from(action, nullptr); }

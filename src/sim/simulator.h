@@ -96,6 +96,14 @@ class Simulator {
   // SimulatorOptions::flow_first: true if settled; else state_.x is `before`
   // again and last_ holds only what was spent.
   bool settle_fast_then_flow(const Eigen::Matrix3Xd& before);
+  // The static solver's polish of a fallback's end state: last_ is its
+  // report with everything spent so far added (spent becomes it); true if
+  // it settled.
+  bool polish(const SettleReport& fallback, SettleReport& spent);
+  // The implicit flow from the current state, then the polish, for up to
+  // `rounds` rounds: a polish that pushes off a saddle and does not settle
+  // again leaves the state beside it, and the flow goes on from there.
+  bool flow_then_polish(int rounds, SettleReport& spent);
   const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
   SimulatorOptions options_;
