@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "calib/effect_scan.h"
+#include "calib/measurement_effects.h"
 
 namespace hj {
 namespace {
@@ -52,6 +53,52 @@ TEST(EffectScan, KeepsTheStartWhereTheDataHaveNoBending) {
   EXPECT_EQ(kappa_bend(scan.best), 0.0);
   EXPECT_EQ(scan.best_sum_sq_mm2, scan.start_sum_sq_mm2);
   EXPECT_TRUE(scan.note.empty());
+}
+
+// A camera tilt changes no surface: its scan replays the dataset once per
+// replay setting, not once per point, and finds the very same figures.
+TEST(EffectScan, ScansAMeasurementEffectOnOneReplayWithTheSameFigures) {
+  const Dataset d = select_sessions(read_dataset(kSessions / "demo-bending"), {"mixed-2"}, true);
+  ModelParams start = with_effects(true_baseline(), {"sensor_tilt"});
+  start.effects = {"sensor_tilt"};  // the data's bending left out: the offset soaks up some of it
+  start.effect_parameters.erase("bending");
+  ReplayOptions replay = fitting_replay({});
+  replay.threads = 1;
+  const auto parameters = fit_parameters({"sensor_tilt"});
+  EffectScanOptions every_point;
+  every_point.reuse_measurement_replays = false;
+  const EffectScan replayed = scan_effect_start(d, start, parameters, "sensor_tilt", replay, every_point);
+  const EffectScan reused = scan_effect_start(d, start, parameters, "sensor_tilt", replay);
+  ASSERT_TRUE(replayed.moved) << "the scan should move something here, or this test shows nothing";
+  EXPECT_EQ(reused.moved, replayed.moved);
+  EXPECT_EQ(reused.note, replayed.note);
+  EXPECT_EQ(reused.start_sum_sq_mm2, replayed.start_sum_sq_mm2);
+  EXPECT_EQ(reused.best_sum_sq_mm2, replayed.best_sum_sq_mm2);
+  EXPECT_EQ(model_params_json(reused.best), model_params_json(replayed.best));
+  EXPECT_EQ(reused.failed, replayed.failed);
+  EXPECT_LE(reused.replays, 2);  // the start's replay settings and the points'
+  EXPECT_GT(replayed.replays, 6);
+}
+
+TEST(CameraFreeReplay, GivesTheReplayedSumOfSquaresAtAnyTiltAndRefusesOtherSurfaces) {
+  const Dataset d = select_sessions(read_dataset(kSessions / "demo-bending"), {"mixed-2"}, true);
+  ModelParams tilted = with_effects(true_baseline(), {"sensor_tilt"});
+  tilted.effect_parameters["sensor_tilt"] = {{"tilt_x_mrad", 3.0}, {"tilt_y_mrad", -7.0}, {"offset_mm", 0.4}};
+  ReplayOptions replay = fitting_replay({});
+  replay.threads = 1;
+  EXPECT_TRUE(is_measurement_only("sensor_tilt"));
+  EXPECT_FALSE(is_measurement_only("bending"));
+  EXPECT_FALSE(is_measurement_only("pressure_offset"));  // it changes the pressure the surface feels
+  const CameraFreeReplay surfaces(d, with_effects(true_baseline(), {"sensor_tilt"}), replay);
+  ASSERT_TRUE(surfaces.replayed());
+  EXPECT_EQ(surfaces.sum_of_squares(tilted), dataset_sum_of_squares(d, tilted, replay));
+  ModelParams level = tilted;
+  level.effect_parameters["sensor_tilt"] = {{"tilt_x_mrad", 0.0}, {"tilt_y_mrad", 0.0}, {"offset_mm", 0.0}};
+  EXPECT_EQ(surfaces.sum_of_squares(level), dataset_sum_of_squares(d, level, replay));
+  EXPECT_NE(surfaces.sum_of_squares(level), surfaces.sum_of_squares(tilted));
+  ModelParams stiffer = tilted;
+  stiffer.surface.spring_k *= 1.01;
+  EXPECT_THROW(surfaces.sum_of_squares(stiffer), std::invalid_argument);
 }
 
 }  // namespace

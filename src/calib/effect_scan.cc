@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <stdexcept>
 
 #include "calib/least_squares.h"
+#include "calib/measurement_effects.h"
 #include "calib/parallel_for.h"
 
 namespace hj {
@@ -24,24 +26,22 @@ struct DirectionResult {
   int replays = 0, failed = 0;
 };
 
+// The sum of squares at a scanned point (infinity: no equilibrium).
+using PointCost = std::function<double(const ModelParams&)>;
+
 // Every point is replayed cold. Not from the last point's states: the
 // points are 3 x apart, and on demo-baseline's bending scan a replay
 // warm-started from the point before took 17-53 s against 8-10 s cold
 // (settles crawling from a far start) and reached other equilibria.
-DirectionResult walk(const Dataset& dataset, const ModelParams& start, const Direction& d,
-                     ReplayOptions replay, const EffectScanOptions& options, int session_threads) {
-  // A point is only a candidate start, so one the static solver cannot
-  // settle is stepped over at once rather than after the fallbacks (a
-  // failed replay with them: about 5 s at 3 x 4; most of a scan's time
-  // where the start sits next to a region with no equilibrium).
-  replay.fallbacks = options.fallbacks;
+DirectionResult walk(const ModelParams& start, const Direction& d, const EffectScanOptions& options,
+                     const PointCost& cost) {
   DirectionResult out;
   int rises = 0;
   for (double fraction : options.fractions) {
     const double value = d.from + fraction * (d.to - d.from);
     ModelParams point = start;
     set_parameter_value(point, d.parameter, value);
-    const double sum_sq = dataset_sum_of_squares(dataset, point, replay, session_threads);
+    const double sum_sq = cost(point);
     ++out.replays;
     if (!std::isfinite(sum_sq)) {
       ++out.failed;  // no equilibrium here: step over it
@@ -78,16 +78,47 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
   // point's sessions too (a one-parameter effect at its bound has a single
   // direction, which would otherwise run on one core).
   const int threads = replay.threads > 0 ? replay.threads : default_thread_count();
-  results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, threads);
-  results[0].replays = 1;
+  // A point is only a candidate start, so one the static solver cannot
+  // settle is stepped over at once rather than after the fallbacks (a
+  // failed replay with them: about 5 s at 3 x 4; most of a scan's time
+  // where the start sits next to a region with no equilibrium).
+  ReplayOptions point_replay = replay;
+  point_replay.fallbacks = options.fallbacks;
   const int session_threads = std::max(1, threads / std::max(1, static_cast<int>(directions.size())));
-  parallel_for(
-      static_cast<int>(directions.size()),
-      [&](int k) { results[k + 1] = walk(dataset, start, directions[k], replay, options, session_threads); },
-      replay.threads);
-  for (const auto& r : results) {
-    out.replays += r.replays;
-    out.failed += r.failed;
+  if (options.reuse_measurement_replays && is_measurement_only(effect)) {
+    // Every point simulates the same surfaces: the dataset is replayed once
+    // with the start's options and once with the points' (they may settle
+    // differently), and the points cost no replay.
+    ReplayOptions start_replay = replay;
+    start_replay.threads = threads;
+    const CameraFreeReplay at_start(dataset, start, start_replay);
+    results[0].best_sum_sq = at_start.sum_of_squares(start);
+    out.replays = 1;
+    std::optional<CameraFreeReplay> own;
+    if (point_replay.fallbacks != replay.fallbacks) {
+      point_replay.threads = threads;
+      own.emplace(dataset, start, point_replay);
+      ++out.replays;
+    }
+    const CameraFreeReplay& at_points = own ? *own : at_start;
+    for (size_t k = 0; k < directions.size(); ++k)
+      results[k + 1] = walk(start, directions[k], options, [&](const ModelParams& p) { return at_points.sum_of_squares(p); });
+    for (const auto& r : results) out.failed += r.failed;
+  } else {
+    results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, threads);
+    results[0].replays = 1;
+    parallel_for(
+        static_cast<int>(directions.size()),
+        [&](int k) {
+          results[k + 1] = walk(start, directions[k], options, [&](const ModelParams& p) {
+            return dataset_sum_of_squares(dataset, p, point_replay, session_threads);
+          });
+        },
+        replay.threads);
+    for (const auto& r : results) {
+      out.replays += r.replays;
+      out.failed += r.failed;
+    }
   }
   out.start_sum_sq_mm2 = out.best_sum_sq_mm2 = results[0].best_sum_sq;
   const bool start_replays = std::isfinite(out.start_sum_sq_mm2);

@@ -15,7 +15,9 @@
 // settle without the fallbacks) are stepped over; a start that does not
 // replay gives way to the best scanned point that does. Every point is
 // replayed cold (effect_scan.cc says why). The directions run in parallel
-// (with fewer directions than threads, each point's sessions too).
+// (with fewer directions than threads, each point's sessions too). A
+// measurement effect's points (a camera tilt) share their surfaces, so the
+// dataset is replayed once for all of them.
 #pragma once
 
 #include <string>
@@ -32,7 +34,7 @@ struct EffectScan {
   double best_sum_sq_mm2 = 0.0;
   bool moved = false;         // best is a scanned point, a real margin below the start
   int replays = 0;            // whole-dataset replays it cost
-  int failed = 0;             // of them, where the model has no equilibrium
+  int failed = 0;             // points where the model has no equilibrium
   std::string note;           // e.g. "bending.kappa_bend 0 -> 0.003 (SSR -54 %)"
 };
 
@@ -47,6 +49,10 @@ struct EffectScanOptions {
   // fallbacks (ReplayOptions::fallbacks); off, a point only they could
   // settle counts as one with no equilibrium.
   bool fallbacks = false;
+  // A measurement-only effect (EffectInfo::measurement_only) is scanned on
+  // one replay of the dataset (measurement_effects.h), with the same
+  // figures; off, every point is replayed (the tests compare the two).
+  bool reuse_measurement_replays = true;
 };
 
 // @param start  the current model's optimum with `effect` switched on at its

@@ -4,15 +4,20 @@
 
 namespace hj {
 
+Eigen::VectorXd sample_x_mm(const SessionGrid& grid) {
+  return Eigen::VectorXd::LinSpaced(grid.nx, 0, grid.nx - 1) * grid.dx_mm + Eigen::VectorXd::Constant(grid.nx, grid.x0_mm);
+}
+
+Eigen::VectorXd sample_y_mm(const SessionGrid& grid) {
+  return Eigen::VectorXd::LinSpaced(grid.ny, 0, grid.ny - 1) * grid.dy_mm + Eigen::VectorXd::Constant(grid.ny, grid.y0_mm);
+}
+
 std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,
                                              const SimulatorOptions& options, const ReplayProgress& progress,
                                              const ReplayTrace* warm_start, ReplayTrace* trace) {
   params.max_pressure_pa = session.device.max_pressure_kpa * 1000.0;
   Simulator sim(session.device.geometry(segments), params, options);
-  const Eigen::VectorXd x_mm = Eigen::VectorXd::LinSpaced(session.grid.nx, 0, session.grid.nx - 1) * session.grid.dx_mm +
-                               Eigen::VectorXd::Constant(session.grid.nx, session.grid.x0_mm);
-  const Eigen::VectorXd y_mm = Eigen::VectorXd::LinSpaced(session.grid.ny, 0, session.grid.ny - 1) * session.grid.dy_mm +
-                               Eigen::VectorXd::Constant(session.grid.ny, session.grid.y0_mm);
+  const Eigen::VectorXd x_mm = sample_x_mm(session.grid), y_mm = sample_y_mm(session.grid);
   std::vector<PredictedCapture> captures;
   const int total = static_cast<int>(session.steps.size());
   if (warm_start && static_cast<int>(warm_start->size()) != total)

@@ -29,6 +29,11 @@ using ReplayProgress = std::function<void(int done, int total, const SessionStep
 // the same session under nearby parameters (Simulator::apply with a start).
 using ReplayTrace = std::vector<Eigen::Matrix3Xd>;
 
+// The sample grid's positions in the device frame (mm), x (nx) and y (ny),
+// as Effect::adjust_measurement takes them.
+Eigen::VectorXd sample_x_mm(const SessionGrid& grid);
+Eigen::VectorXd sample_y_mm(const SessionGrid& grid);
+
 // The session's device with `params` (whose max pressure is replaced by the
 // session's). Throws SessionError naming the step when an action fails.
 std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 
 #include "calib/parallel_for.h"
 
@@ -164,7 +166,13 @@ int residual_count(const MeasuredSession& session) {
 
 Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelParams& params,
                                   const ReplayOptions& options, const ReplayTrace* warm_start, ReplayTrace* trace) {
-  const auto predicted = predict(session, params, options, warm_start, trace);
+  return capture_residuals(session, predict(session, params, options, warm_start, trace));
+}
+
+Eigen::VectorXd capture_residuals(const MeasuredSession& session, const std::vector<PredictedCapture>& predicted) {
+  if (predicted.size() != session.captures.size())
+    throw std::invalid_argument("capture_residuals: " + std::to_string(predicted.size()) + " predicted captures for " +
+                                session.session.name + "'s " + std::to_string(session.captures.size()));
   Eigen::VectorXd out(residual_count(session));
   int k = 0;
   for (size_t c = 0; c < session.captures.size(); ++c) {

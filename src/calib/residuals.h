@@ -114,6 +114,9 @@ Eigen::VectorXd session_residuals(const MeasuredSession& session, const ModelPar
                                   const ReplayOptions& options, const ReplayTrace* warm_start = nullptr,
                                   ReplayTrace* trace = nullptr);
 int residual_count(const MeasuredSession& session);
+// The same residuals from captures already predicted (one per capture of
+// the session, in order).
+Eigen::VectorXd capture_residuals(const MeasuredSession& session, const std::vector<PredictedCapture>& predicted);
 
 // The sum of squares of every session's residuals at params, the sessions
 // replayed one after another (for callers that run several points in

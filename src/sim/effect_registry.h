@@ -36,6 +36,12 @@ struct EffectInfo {
   // Builds the effect with every parameter given (resolved values). Baseline
   // effects ignore the map and read SurfaceParameters.
   std::function<std::unique_ptr<Effect>(const EffectParameterValues&)> make;
+  // True for an effect that only changes what the camera reports
+  // (Effect::adjust_measurement): no forces, no stiffness, no state. Its
+  // values then leave the simulated surfaces alone, so a calibration scan
+  // over them replays the dataset once (calib/effect_scan.h). Claiming it
+  // for an effect with forces makes those scans wrong.
+  bool measurement_only = false;
 };
 
 // `given` completed with the defaults of `info`. Throws std::invalid_argument

@@ -42,7 +42,8 @@ HJ_REGISTER_EFFECT(EffectInfo{"sensor_tilt",
                               [](const EffectParameterValues& v) {
                                 return std::make_unique<SensorTilt>(v.at("tilt_x_mrad"), v.at("tilt_y_mrad"),
                                                                     v.at("offset_mm"));
-                              }});
+                              },
+                              /*measurement_only=*/true});
 
 }  // namespace
 }  // namespace hj
