@@ -23,16 +23,18 @@ struct Direction {
 struct DirectionResult {
   double best_sum_sq = std::numeric_limits<double>::infinity();
   double value = 0.0;
-  int replays = 0, failed = 0;
+  int replays = 0, failed = 0;  // points costed, and of them with no equilibrium
 };
 
 // The sum of squares at a scanned point (infinity: no equilibrium).
 using PointCost = std::function<double(const ModelParams&)>;
 
-// Every point is replayed cold. Not from the last point's states: the
-// points are 3 x apart, and on demo-baseline's bending scan a replay
-// warm-started from the point before took 17-53 s against 8-10 s cold
-// (settles crawling from a far start) and reached other equilibria.
+// Walks one direction, each point costed by `cost` (a replay of the
+// dataset, or a measurement effect's reused one). Every point is replayed
+// cold. Not from the last point's states: the points are 3 x apart, and on
+// demo-baseline's bending scan a replay warm-started from the point before
+// took 17-53 s against 8-10 s cold (settles crawling from a far start) and
+// reached other equilibria.
 DirectionResult walk(const ModelParams& start, const Direction& d, const EffectScanOptions& options,
                      const PointCost& cost) {
   DirectionResult out;
