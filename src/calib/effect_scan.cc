@@ -30,8 +30,8 @@ struct DirectionResult {
 using PointCost = std::function<double(const ModelParams&)>;
 
 // Walks one direction, each point costed by `cost` (a replay of the
-// dataset, or a measurement effect's reused one). Every point is replayed
-// cold. Not from the last point's states: the points are 3 x apart, and on
+// dataset, or a measurement effect's reused one). Replays are cold. Not
+// from the last point's states: the points are 3 x apart, and on
 // demo-baseline's bending scan a replay warm-started from the point before
 // took 17-53 s against 8-10 s cold (settles crawling from a far start) and
 // reached other equilibria.

@@ -1,11 +1,7 @@
 #include "calib/measurement_effects.h"
 
-#include <algorithm>
 #include <limits>
-#include <memory>
 #include <stdexcept>
-
-#include "model/mesh.h"
 
 namespace hj {
 
@@ -25,16 +21,21 @@ ModelParams without_measurement_effects(ModelParams params) {
 }
 
 CameraFreeReplay::CameraFreeReplay(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options)
-    : dataset_(dataset), segments_(options.segments), physical_(without_measurement_effects(params)) {
+    : dataset_(dataset), physical_(without_measurement_effects(params)) {
+  Evaluation replay;
   try {
-    Evaluation replay = evaluate_dataset(dataset, physical_, options);
-    for (SessionEvaluation& session : replay.sessions) captures_.push_back(std::move(session.predicted));
-    replayed_ = true;
+    replay = evaluate_dataset(dataset, physical_, options);
   } catch (const SettleInterrupted&) {
     throw;  // the caller stopped the work: not a failed replay
   } catch (const std::exception&) {
-    captures_.clear();  // no equilibrium somewhere: every point fails
+    return;  // no equilibrium somewhere: every point fails
   }
+  for (size_t s = 0; s < dataset.sessions.size(); ++s) {
+    const Session& session = dataset.sessions[s].session;
+    sessions_.push_back({Mesh(session.device.geometry(options.segments)), sample_x_mm(session.grid),
+                         sample_y_mm(session.grid), std::move(replay.sessions[s].predicted)});
+  }
+  replayed_ = true;
 }
 
 double CameraFreeReplay::sum_of_squares(const ModelParams& params) const {
@@ -43,14 +44,12 @@ double CameraFreeReplay::sum_of_squares(const ModelParams& params) const {
   if (!replayed_) return std::numeric_limits<double>::infinity();
   const auto effects = make_effects(params.effects, params.effect_parameters);
   double sum = 0.0;
-  for (size_t s = 0; s < dataset_.sessions.size(); ++s) {
-    const MeasuredSession& measured = dataset_.sessions[s];
-    const Mesh mesh(measured.session.device.geometry(segments_));
-    const Eigen::VectorXd x_mm = sample_x_mm(measured.session.grid), y_mm = sample_y_mm(measured.session.grid);
-    std::vector<PredictedCapture> seen = captures_[s];
+  for (size_t s = 0; s < sessions_.size(); ++s) {
+    const SessionView& view = sessions_[s];
+    std::vector<PredictedCapture> seen = view.captures;
     for (PredictedCapture& capture : seen)
-      for (const auto& effect : effects) effect->adjust_measurement(mesh, x_mm, y_mm, capture.heights_mm);
-    sum += capture_residuals(measured, seen).squaredNorm();  // in session order, as dataset_sum_of_squares()
+      for (const auto& effect : effects) effect->adjust_measurement(view.mesh, view.x_mm, view.y_mm, capture.heights_mm);
+    sum += capture_residuals(dataset_.sessions[s], seen).squaredNorm();  // in session order, as dataset_sum_of_squares()
   }
   return sum;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "calib/residuals.h"
+#include "model/mesh.h"
 
 namespace hj {
 
@@ -39,11 +40,16 @@ class CameraFreeReplay {
   double sum_of_squares(const ModelParams& params) const;
 
  private:
+  // What the camera needs of each session, made once for every point.
+  struct SessionView {
+    Mesh mesh;
+    Eigen::VectorXd x_mm, y_mm;  // the sample grid (sample_x_mm, sample_y_mm)
+    std::vector<PredictedCapture> captures;
+  };
   const Dataset& dataset_;
-  int segments_;
   ModelParams physical_;
   bool replayed_ = false;
-  std::vector<std::vector<PredictedCapture>> captures_;  // by session, by capture
+  std::vector<SessionView> sessions_;  // by session
 };
 
 }  // namespace hj
