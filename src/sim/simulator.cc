@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
+#include "sim/coarse_start.h"
 #include "sim/effect_registry.h"
 #include "sim/jamming_springs.h"
 #include "sim/levelling_crossing.h"
@@ -27,6 +29,18 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
   if (options_.interrupted)
     options_.static_options.interrupted = options_.explicit_options.interrupted = options_.flow_options.interrupted =
         options_.interrupted;
+  // Below this many free DOFs a settle step costs well under a millisecond
+  // and the mirrored start's few steps are not worth a second mesh.
+  constexpr int kCoarseStartMinDofs = 1500;
+  const Mesh& mesh = model_.mesh();
+  const int free_dofs = 3 * (mesh.point_rows() - 2) * (mesh.point_cols() - 2);
+  if (const int coarse = coarse_segments(mesh.segments());
+      options_.coarse_start && options_.solver == SolverKind::kStatic && coarse > 0 && free_dofs >= kCoarseStartMinDofs) {
+    ArrayGeometry g = mesh.geometry();
+    g.segments = coarse;
+    coarse_model_ = std::make_unique<ForceModel>(Mesh(g), params,
+                                                 make_effects(options_.extra_effects, options_.effect_parameters));
+  }
   state_ = DeviceState::flat(model_.mesh());
   settle();
 }
@@ -147,7 +161,14 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
   switch (action.op) {
     case Action::Op::kSetPressure:
       if (!start && options_.solver == SolverKind::kStatic) {
-        predicted = levelling_crossing_start(model_, state_, action.pressure_pa);
+        if (coarse_model_) {
+          if (auto coarse = coarse_mesh_start(model_, *coarse_model_, state_, action.pressure_pa,
+                                              options_.static_options)) {
+            predicted = std::move(coarse->x);
+            if (coarse->marginal_mode.size() > 0) settle_memory_.marginal_mode = std::move(coarse->marginal_mode);
+          }
+        }
+        if (!predicted) predicted = levelling_crossing_start(model_, state_, action.pressure_pa);
         if (predicted) start = &*predicted;
       }
       state_.pressure_pa = action.pressure_pa;

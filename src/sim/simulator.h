@@ -50,6 +50,10 @@ struct SimulatorOptions {
   // (79 jams of a 9 x 12 plan cost about 3 s otherwise). Unjam and unpin
   // can destabilise and always settle in full.
   bool skip_settle_after_jam_or_pin = true;
+  // A free net carried across levelling on a large mesh (at least 1,500
+  // free DOFs, p >= 4) starts from the same settle on a mesh of half the
+  // segments (coarse_start.h) rather than from the mirrored sag alone.
+  bool coarse_start = true;
   // Effects beyond the baseline, by registry name, and their parameter
   // values (effect name -> parameter name -> value; missing = default).
   std::vector<std::string> extra_effects;
@@ -108,6 +112,9 @@ class Simulator {
 
   SimulatorOptions options_;
   ForceModel model_;
+  // The same effects on the coarser mesh (SimulatorOptions::coarse_start),
+  // or null where the mesh is too small for it to pay.
+  std::unique_ptr<ForceModel> coarse_model_;
   DeviceState state_;
   SettleReport last_;
   SettleMemory settle_memory_;
