@@ -120,6 +120,8 @@ class Simulator {
   SettleMemory settle_memory_;
   // Set by apply_from while a jam or pin settles (skip_settle_after_jam_or_pin).
   bool keeps_equilibrium_ = false;
+  // Set by apply_from while a settle starts from the coarse mesh's dome.
+  bool close_start_ = false;
 };
 
 // Parses "static" / "explicit"; std::invalid_argument otherwise.
