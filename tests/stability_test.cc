@@ -51,6 +51,20 @@ TEST(DivergenceMode, ANegativeEigenvalueOfSymKAloneIsNotADivergence) {
   EXPECT_EQ(divergence_mode(sparse(k)).size(), 0);
 }
 
+TEST(DivergenceSearch, AsksAboutAKnownModeAndAgreesWithTheFullSearch) {
+  const Eigen::SparseMatrix<double> saddle = sparse(Eigen::Vector3d(2.0, 1.0, -0.5).asDiagonal());
+  const Eigen::Vector3d near_mode = Eigen::Vector3d(0.1, 0.1, 1.0).normalized();
+  DivergenceSearch search(saddle);
+  EXPECT_TRUE(search.still_has(near_mode, 0.9)) << "inverse iteration from near the mode";
+  EXPECT_FALSE(search.still_has(Eigen::Vector3d(1.0, 0.0, 0.0), 0.9)) << "a stable direction stays stable";
+  EXPECT_FALSE(search.still_has(Eigen::Vector2d(0.0, 1.0), 0.9)) << "a mode of another size";
+  EXPECT_EQ(search.mode(), divergence_mode(saddle));
+  const Eigen::SparseMatrix<double> definite = sparse(Eigen::Vector3d(2.0, 1.0, 0.5).asDiagonal());
+  DivergenceSearch stable(definite);
+  EXPECT_FALSE(stable.still_has(Eigen::Vector3d(0.0, 0.0, 1.0), 0.9));
+  EXPECT_EQ(stable.mode().size(), 0);
+}
+
 const ArrayGeometry kPaper{3, 4, 0.038, 4};
 
 TEST(LevellingCrossing, OnlyForAFreeNetWhoseLoadChangesSign) {

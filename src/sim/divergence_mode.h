@@ -22,7 +22,9 @@ Eigen::VectorXd divergence_mode(const Eigen::SparseMatrix<double>& stiffness);
 // that already knows a mode (SettleMemory) can ask about it first.
 class DivergenceSearch {
  public:
+  // `stiffness` is read, not copied: it must outlive the search.
   explicit DivergenceSearch(const Eigen::SparseMatrix<double>& stiffness);
+  DivergenceSearch(Eigen::SparseMatrix<double>&&) = delete;
   ~DivergenceSearch();
 
   // The divergence_mode() of the stiffness.
