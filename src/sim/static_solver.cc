@@ -7,8 +7,10 @@
 #include <string>
 
 #include "sim/divergence_mode.h"
+#include "sim/mirror_symmetry.h"
 #include "sim/process_tuning.h"
 #include "sim/shifted_solver.h"
+#include "sim/step_system.h"
 #include "sim/stiffness_matrix.h"
 
 namespace hj {
@@ -39,6 +41,10 @@ constexpr double kAbandonGrowth = 100.0;
 // Refused careful steps after which the control remembers the shifts it
 // refused (see run_continuation).
 constexpr int kRefusalsBeforeMemory = 50;
+// Free DOFs from which a settle first tries the symmetric displacements
+// alone: the paper's 3 x 4 array (495) settles in a few milliseconds
+// without them, and its fits keep their rounding.
+constexpr int kMinMirrorDofs = 1000;
 // Refused fast steps after which a push off a saddle is given up. Leaving a
 // saddle raises the residual, and the fast control refuses a step whose
 // residual grows tenfold and starts its shift again from mu0: each refusal
@@ -49,13 +55,6 @@ constexpr int kRefusalsBeforeMemory = 50;
 // second 4-12 steps after the push, not 21), and the 11 that reached one
 // (in 8-15 steps) at most once; the outcome is the same, only sooner.
 constexpr int kPushRefusals = 2;
-
-// Adds mu to the diagonal of K (3 x 3 identity blocks at every free point).
-void add_shift(StiffnessMatrix& k, double mu) {
-  if (mu == 0.0) return;
-  const Eigen::Matrix3d shift = mu * Eigen::Matrix3d::Identity();
-  for (int p : k.free_points()) k.add(p, p, shift);
-}
 
 // How the shift mu follows the iterations.
 enum class StepControl {
@@ -80,33 +79,39 @@ enum class StepControl {
 // and the linear model fails even for 0.01 mm steps (the creased sag of a
 // 6 x 8 array with 12 jammed cells at 0.96 of levelling: no convergence in
 // 1000 steps; with this, 434). Skipped where the correction is not small.
-void add_geodesic_acceleration(const ForceModel& model, const DeviceState& state, const StiffnessMatrix& k,
+void add_geodesic_acceleration(const ForceModel& model, const DeviceState& state, const StepSystem& system,
                                ShiftedSolver& solver, double mu, const Eigen::VectorXd& residual,
                                Eigen::VectorXd& step) {
   constexpr double kProbe = 0.1, kMaxRatio = 0.75;
   Eigen::Matrix3Xd f_probe;
-  model.forces(state, state.x + k.scatter(kProbe * step), f_probe);
+  model.forces(state, state.x + system.scatter(kProbe * step), f_probe);
   // F(x + h v) = F - h K v + h^2 F''/2, and K v = F - mu v.
   const Eigen::VectorXd second =
-      (2.0 / (kProbe * kProbe)) * (k.gather(f_probe) - residual + kProbe * (residual - mu * step));
+      (2.0 / (kProbe * kProbe)) * (system.gather(f_probe) - residual + kProbe * (residual - mu * step));
   Eigen::VectorXd accel;
-  if (!solver.solve_again(k.matrix(), mu, second, accel) || !accel.allFinite()) return;
+  if (!solver.solve_again(system.matrix(), mu, second, accel) || !accel.allFinite()) return;
   if (2.0 * accel.norm() <= kMaxRatio * step.norm()) step += 0.5 * accel;
 }
 
 // Iterates from state.x; returns with report.converged set when a stable
 // equilibrium (or max_restarts pushes) is reached within max_iterations.
-void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatrix& k, ShiftedSolver& solver,
-                      const std::vector<char>& fixed, const StaticSolverOptions& options, StepControl control,
-                      int max_iterations, double mu0, SettleMemory& memory, SettleReport& report) {
+// The steps are solved in `system`'s DOFs. Over a mirror subspace only the
+// fast control runs, without the stability check, which must see every DOF
+// (k): the careful controls' model tests are written for the full system.
+void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatrix& k, StepSystem& system,
+                      ShiftedSolver& solver, const std::vector<char>& fixed, const StaticSolverOptions& options,
+                      StepControl control, int max_iterations, double mu0, SettleMemory& memory,
+                      SettleReport& report) {
+  if (system.num_dofs() != k.num_dofs() && (control != StepControl::kDisplacement || options.check_stability))
+    throw std::logic_error("run_continuation: a subspace settle is the fast control without the stability check");
   const Mesh& mesh = model.mesh();
   const double max_step =
       (control == StepControl::kDisplacement ? options.fast_step_fraction : options.max_step_fraction) * mesh.spacing();
   Eigen::Matrix3Xd f, f_trial;
   model.forces(state, state.x, f);
-  Eigen::VectorXd residual = k.gather(f);
+  Eigen::VectorXd residual = system.gather(f);
   double mu = mu0;
-  const double start_norm = residual.norm();
+  const double start_norm = system.force_norm(residual);
   double refused_mu = 0.0;  // the largest shift the careful control refused
   int refusals = 0;
   // The equilibrium last pushed off, and the iteration of the push.
@@ -117,10 +122,8 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
   // The residual norm when it last halved, and that iteration (stall_iterations).
   double halved_norm = start_norm;
   int halved_at = 0;
-  // K at state.x before the shift, kept for the steps after a refused one
-  // (the careful control refuses about a third of its steps on stiff jammed
-  // cells): only the shift changes there, so K is not assembled again.
-  Eigen::VectorXd unshifted;
+  // Whether system holds K at state.x (kept for the steps after a refused
+  // one, where only the shift changes).
   bool unshifted_current = false;
   // A push that has not led to another equilibrium within its budget was
   // along a mode too weak to matter: settle for the equilibrium it left.
@@ -174,42 +177,40 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       state.x += (0.05 * mesh.spacing() / largest) * push;
       unshifted_current = false;
       model.forces(state, state.x, f);
-      residual = k.gather(f);
+      residual = system.gather(f);
       mu = mu0;
       ++report.restarts;
-      halved_norm = residual.norm();
+      halved_norm = system.force_norm(residual);
       halved_at = it;
       continue;
     }
-    if (const double norm = residual.norm(); norm < 0.5 * halved_norm) {
+    if (const double norm = system.force_norm(residual); norm < 0.5 * halved_norm) {
       halved_norm = norm;
       halved_at = it;
     } else if (control != StepControl::kDisplacement && pushed_at < 0 && it - halved_at > options.stall_iterations) {
       break;  // stalled: nothing to converge to
     }
-    if (unshifted_current) {
-      k.matrix().coeffs() = unshifted;
-    } else {
-      k.set_zero();
-      model.add_stiffness(state, state.x, k);
-      unshifted = k.matrix().coeffs();
+    if (!unshifted_current) {
+      system.assemble(model, state, state.x);
       unshifted_current = true;
     }
-    add_shift(k, mu);
+    system.set_shift(mu);
     Eigen::VectorXd full_step;
-    const double largest = solver.solve(k.matrix(), mu, residual, full_step)
-                               ? full_step.reshaped(3, full_step.size() / 3).colwise().norm().maxCoeff()
+    const double largest = solver.solve(system.matrix(), mu, residual, full_step)
+                               ? system.scatter(full_step).colwise().norm().maxCoeff()
                                : NAN;
     if (!std::isfinite(largest)) {
       mu = std::max(4.0 * mu, mu0);
       continue;
     }
-    if (control == StepControl::kCurvedModelTrust) add_geodesic_acceleration(model, state, k, solver, mu, residual, full_step);
-    const double scale = std::min(1.0, max_step / full_step.reshaped(3, full_step.size() / 3).colwise().norm().maxCoeff());
-    const Eigen::Matrix3Xd x_trial = state.x + k.scatter(scale * full_step);
+    if (control == StepControl::kCurvedModelTrust)
+      add_geodesic_acceleration(model, state, system, solver, mu, residual, full_step);
+    const Eigen::Matrix3Xd move = system.scatter(full_step);
+    const double scale = std::min(1.0, max_step / move.colwise().norm().maxCoeff());
+    const Eigen::Matrix3Xd x_trial = state.x + scale * move;
     model.forces(state, x_trial, f_trial);
-    const Eigen::VectorXd residual_trial = k.gather(f_trial);
-    const double old_norm = residual.norm(), new_norm = residual_trial.norm();
+    const Eigen::VectorXd residual_trial = system.gather(f_trial);
+    const double old_norm = system.force_norm(residual), new_norm = system.force_norm(residual_trial);
     if (control == StepControl::kDisplacement) {
       // Heading away (stiff jammed cells turned by straight strides): leave
       // it to the careful control rather than spend the budget.
@@ -228,8 +229,8 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       // whose error those springs take back at once were refused (3 x 4, all
       // jammed, 295 -> 0 Pa: 158 steps in the plain norm, 58 in this one).
       Eigen::VectorXd correction, compliance_step;
-      const bool solved = solver.solve_again(k.matrix(), mu, residual_trial, correction) &&
-                          solver.solve_again(k.matrix(), mu, full_step, compliance_step);
+      const bool solved = solver.solve_again(system.matrix(), mu, residual_trial, correction) &&
+                          solver.solve_again(system.matrix(), mu, full_step, compliance_step);
       const Eigen::VectorXd predicted = (1.0 - scale) * full_step + (scale * mu) * compliance_step;
       const double rho = solved ? (correction - predicted).norm() / std::max((full_step - predicted).norm(), 1e-300)
                                 : INFINITY;
@@ -276,6 +277,38 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
   report.residual_n = max_free_force(f, fixed);
 }
 
+// The fast control on the displacements that keep the state's mirror
+// symmetry (mirror_symmetry.h), if it has one: its equilibrium is one of
+// the full system, whose stability the full settle then checks. state.x is
+// left there if it converged, as it was otherwise; report counts the steps.
+// From a symmetric state the fast control's steps
+// on all DOFs are the same steps (K and F keep the symmetry, and the
+// residual norms are weighted to match), so where this one fails that one
+// would too, and is not run.
+enum class SymmetricSettle { kNotTried, kSettled, kFailed };
+SymmetricSettle settle_mirror_symmetric(const ForceModel& model, DeviceState& state, StiffnessMatrix& k,
+                                        const std::vector<char>& fixed, const StaticSolverOptions& options,
+                                        double mu0, SettleReport& report) {
+  const MirrorGroup group = mirror_symmetry_of(model, state);
+  if (group.trivial()) return SymmetricSettle::kNotTried;
+  const Eigen::Matrix3Xd start_x = state.x;
+  state.x = mirror_average(model.mesh(), state.x, group, fixed);
+  const MirrorSubspace subspace(model.mesh(), k, group);
+  StepSystem system(k, subspace);
+  ShiftedSolver solver;
+  StaticSolverOptions symmetric = options;
+  symmetric.check_stability = false;
+  SettleMemory unused;
+  SettleReport tried;
+  run_continuation(model, state, k, system, solver, fixed, symmetric, StepControl::kDisplacement,
+                   options.fast_iterations, mu0, unused, tried);
+  report.iterations += tried.iterations;
+  report.residual_n = tried.residual_n;
+  if (tried.converged) return SymmetricSettle::kSettled;
+  state.x = start_x;
+  return SymmetricSettle::kFailed;
+}
+
 }  // namespace
 
 SettleReport settle_static(const ForceModel& model, DeviceState& state, const StaticSolverOptions& options,
@@ -293,14 +326,20 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
     return report;
   }
   tune_process_for_settling();
-  ShiftedSolver solver;
   const double mu0 = options.initial_shift * model.params().spring_k;
-  // The fast control first, within a small budget; where it does not
-  // settle, the careful one from the same start.
   const Eigen::Matrix3Xd start_x = state.x;
-  if (options.fast_iterations > 0) {
-    run_continuation(model, state, k, solver, fixed, options, StepControl::kDisplacement, options.fast_iterations, mu0,
-                     remembered, report);
+  // The fast control first, within a small budget (on the symmetric
+  // displacements where the state has a mirror symmetry); where it does
+  // not settle, the careful one from the same start.
+  const bool fast_failed = options.mirror_symmetry && options.fast_iterations > 0 &&
+                           k.num_dofs() >= kMinMirrorDofs &&
+                           settle_mirror_symmetric(model, state, k, fixed, options, mu0, report) ==
+                               SymmetricSettle::kFailed;
+  StepSystem system(k);
+  ShiftedSolver solver;
+  if (options.fast_iterations > 0 && !fast_failed) {
+    run_continuation(model, state, k, system, solver, fixed, options, StepControl::kDisplacement,
+                     options.fast_iterations, mu0, remembered, report);
     if (!report.converged) {
       state.x = start_x;
       report.restarts = 0;
@@ -311,16 +350,16 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
     return report;
   }
   if (!report.converged)
-    run_continuation(model, state, k, solver, fixed, options, StepControl::kModelTrust, options.max_iterations, mu0,
-                     remembered, report);
+    run_continuation(model, state, k, system, solver, fixed, options, StepControl::kModelTrust, options.max_iterations,
+                     mu0, remembered, report);
   // The curved steps change which of two nearby equilibria a settle finds
   // in some cases that settle without them, so they are the last resort,
   // not the default (measured on the fit tests' held-out sessions).
   if (!report.converged) {
     state.x = start_x;
     report.restarts = 0;
-    run_continuation(model, state, k, solver, fixed, options, StepControl::kCurvedModelTrust, options.max_iterations,
-                     mu0, remembered, report);
+    run_continuation(model, state, k, system, solver, fixed, options, StepControl::kCurvedModelTrust,
+                     options.max_iterations, mu0, remembered, report);
   }
   report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return report;

@@ -47,6 +47,12 @@ struct StaticSolverOptions {
   // the ones that failed, 176 of 207 never halved in their last 900.
   int stall_iterations = 500;
   bool check_stability = true;
+  // Settle a mirror-symmetric state (mirror_symmetry.h: a free net under
+  // uniform pressure, a symmetric pattern of jams and pins) on its symmetric
+  // displacements first, a quarter or half of the unknowns, then check the
+  // equilibrium's stability over all of them. Only on meshes of 1,000 free
+  // DOFs or more.
+  bool mirror_symmetry = true;
   // false: give up when the fast control does not settle, without the
   // careful ones (the simulator then tries the implicit flow first).
   bool careful = true;
