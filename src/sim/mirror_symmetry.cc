@@ -17,6 +17,9 @@ int image(const Mesh& mesh, int g, int p) {
 // D_g's entry for component c: a mirror in x flips x, one in y flips y.
 int flip(int g, int c) { return (c == 0 && (g & 1)) || (c == 1 && (g & 2)) ? -1 : 1; }
 
+// chi(g) of the character with odd elements `odd`.
+double character(unsigned odd, int g) { return (odd >> g) & 1u ? -1.0 : 1.0; }
+
 Eigen::Vector3d mirrored(int g, const Eigen::Vector3d& v) { return {flip(g, 0) * v.x(), flip(g, 1) * v.y(), v.z()}; }
 
 // Clamped and pinned points and jammed cells map onto themselves under g.
@@ -43,20 +46,33 @@ MirrorGroup largest_subgroup(unsigned passing) {
 
 int MirrorGroup::order() const { return has(1) + has(2) + has(3); }
 
-Eigen::Matrix3Xd mirror_average(const Mesh& mesh, const Eigen::Matrix3Xd& x, MirrorGroup group,
-                                const std::vector<char>& fixed) {
-  const Eigen::Matrix3Xd flat = mesh.rest_positions();
-  const Eigen::Matrix3Xd u = x - flat;
-  Eigen::Matrix3Xd out = x;
+Eigen::Matrix3Xd mirror_projection(const Mesh& mesh, const Eigen::Matrix3Xd& u, MirrorGroup group, unsigned odd,
+                                   const std::vector<char>& fixed) {
+  Eigen::Matrix3Xd out = Eigen::Matrix3Xd::Zero(3, mesh.num_points());
   const double count = group.order() + 1;
   for (int p = 0; p < mesh.num_points(); ++p) {
     if (fixed[p]) continue;
     Eigen::Vector3d sum = u.col(p);
     for (int g = 1; g <= 3; ++g)
-      if (group.has(g)) sum += mirrored(g, u.col(image(mesh, g, p)));
-    out.col(p) = flat.col(p) + sum / count;
+      if (group.has(g)) sum += character(odd, g) * mirrored(g, u.col(image(mesh, g, p)));
+    out.col(p) = sum / count;
   }
   return out;
+}
+
+Eigen::Matrix3Xd mirror_average(const Mesh& mesh, const Eigen::Matrix3Xd& x, MirrorGroup group,
+                                const std::vector<char>& fixed) {
+  const Eigen::Matrix3Xd flat = mesh.rest_positions();
+  Eigen::Matrix3Xd out = flat + mirror_projection(mesh, x - flat, group, 0, fixed);
+  for (int p = 0; p < mesh.num_points(); ++p)
+    if (fixed[p]) out.col(p) = x.col(p);
+  return out;
+}
+
+std::vector<unsigned> mirror_characters(MirrorGroup group) {
+  if (group.trivial()) return {0u};
+  if (group.order() == 1) return {0u, group.elements & ~1u};
+  return {0u, 0b1010u, 0b1100u, 0b0110u};  // odd in x, odd in y, odd in both mirrors but not their product
 }
 
 MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state, double position_tolerance_m) {
@@ -99,7 +115,7 @@ MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state
   return largest_subgroup(forces_passing);
 }
 
-MirrorSubspace::MirrorSubspace(const Mesh& mesh, const StiffnessMatrix& full, MirrorGroup group)
+MirrorSubspace::MirrorSubspace(const Mesh& mesh, const StiffnessMatrix& full, MirrorGroup group, unsigned odd)
     : full_(full), num_points_(mesh.num_points()), unknown_of_dof_(full.num_dofs(), -1), sign_of_dof_(full.num_dofs(), 0) {
   auto representative = [&](int p) {
     int rep = p;
@@ -113,7 +129,7 @@ MirrorSubspace::MirrorSubspace(const Mesh& mesh, const StiffnessMatrix& full, Mi
       // A mirror that fixes the point and flips the component holds it at 0.
       bool free = true;
       for (int g = 1; g <= 3; ++g)
-        if (group.has(g) && image(mesh, g, p) == p && flip(g, c) < 0) free = false;
+        if (group.has(g) && image(mesh, g, p) == p && character(odd, g) * flip(g, c) < 0) free = false;
       if (!free) continue;
       unknown_of_dof_[full.dof(p, c)] = num_dofs_++;
       sign_of_dof_[full.dof(p, c)] = 1;
@@ -127,7 +143,8 @@ MirrorSubspace::MirrorSubspace(const Mesh& mesh, const StiffnessMatrix& full, Mi
     while (!(group.has(g) && image(mesh, g, rep) == p)) ++g;
     for (int c = 0; c < 3; ++c) {
       unknown_of_dof_[full.dof(p, c)] = unknown_of_dof_[full.dof(rep, c)];
-      sign_of_dof_[full.dof(p, c)] = static_cast<signed char>(flip(g, c) * sign_of_dof_[full.dof(rep, c)]);
+      sign_of_dof_[full.dof(p, c)] =
+          static_cast<signed char>(character(odd, g) * flip(g, c) * sign_of_dof_[full.dof(rep, c)]);
     }
   }
   weights_ = Eigen::VectorXd::Zero(num_dofs_);

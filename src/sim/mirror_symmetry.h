@@ -34,11 +34,22 @@ struct MirrorGroup {
   bool trivial() const { return elements == 1u; }
 };
 
+// The orthogonal projection of a displacement field u (3 x N) onto the
+// fields that `group` maps onto themselves times the character `odd` (bit
+// g set: element g maps the field onto minus itself; a character, so odd
+// must be closed as one: 0, or the bits of an element and of the other
+// one it is composed with). Fixed points get 0.
+Eigen::Matrix3Xd mirror_projection(const Mesh& mesh, const Eigen::Matrix3Xd& u, MirrorGroup group, unsigned odd,
+                                   const std::vector<char>& fixed);
+
 // Positions x with the displacements of the points not `fixed` from the
 // flat grid averaged over their images under `group` (the orthogonal
 // projection onto the symmetric displacements); fixed points unchanged.
 Eigen::Matrix3Xd mirror_average(const Mesh& mesh, const Eigen::Matrix3Xd& x, MirrorGroup group,
                                 const std::vector<char>& fixed);
+
+// The characters of `group` as `odd` masks: the symmetric one (0) first.
+std::vector<unsigned> mirror_characters(MirrorGroup group);
 
 // The largest subgroup under which `state` is symmetric for `model`: the
 // clamped and pinned points and jammed cells map onto themselves, the
@@ -49,17 +60,19 @@ Eigen::Matrix3Xd mirror_average(const Mesh& mesh, const Eigen::Matrix3Xd& x, Mir
 MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state,
                                double position_tolerance_m = 1e-9);
 
-// The displacements of the free points that `group` leaves unchanged: one
+// The displacements of the free points that `group` maps onto themselves
+// (times the character `odd`, see mirror_projection; 0: unchanged): one
 // unknown per orbit of (point, component), with the component zero where a
 // mirror that fixes the point flips it. S maps the unknowns to the free
 // DOFs of `full` (entries +-1); the settle solves S^T (K + mu I) S dy =
-// S^T F and moves by S dy.
+// S^T F and moves by S dy. At a symmetric state K maps each character's
+// displacements onto themselves, so its eigenvectors lie in one each.
 class MirrorSubspace {
  public:
   // `full` gives the free DOFs and the stiffness pattern; the subspace keeps
   // a reference to it, which must outlive it. `fixed` must be symmetric.
-  MirrorSubspace(const Mesh& mesh, const StiffnessMatrix& full, MirrorGroup group);
-  MirrorSubspace(const Mesh&, StiffnessMatrix&&, MirrorGroup) = delete;
+  MirrorSubspace(const Mesh& mesh, const StiffnessMatrix& full, MirrorGroup group, unsigned odd = 0);
+  MirrorSubspace(const Mesh&, StiffnessMatrix&&, MirrorGroup, unsigned = 0) = delete;
 
   int num_dofs() const { return num_dofs_; }
   // S^T of a point field (forces): its free points summed over each orbit.

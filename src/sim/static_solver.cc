@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "sim/process_tuning.h"
 #include "sim/shifted_solver.h"
 #include "sim/step_system.h"
+#include "sim/symmetric_stability.h"
 #include "sim/stiffness_matrix.h"
 
 namespace hj {
@@ -152,7 +154,12 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       // at 2 kPa: 53 -> 19 ms on 2026-11-25's machine).
       constexpr double kSameMode = 0.9;
       DivergenceSearch search(k.matrix());
-      if (search.still_has(memory.marginal_mode, kSameMode)) {
+      // At a mirror-symmetric state, asked of the mode's symmetry class only.
+      const std::optional<bool> known_in_class =
+          options.mirror_symmetry && memory.marginal_mode.size() > 0 && k.num_dofs() >= kMinMirrorDofs
+              ? still_has_in_mirror_class(mesh, k, mirror_symmetry_of(model, state), memory.marginal_mode, kSameMode)
+              : std::nullopt;
+      if (known_in_class ? *known_in_class : search.still_has(memory.marginal_mode, kSameMode)) {
         report.converged = report.marginal = true;
         return;
       }
