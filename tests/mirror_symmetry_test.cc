@@ -183,6 +183,21 @@ TEST(MirrorSymmetricSettle, ReachesTheFullSettlesEquilibria) {
   EXPECT_LT((full_x - symmetric_x).cwiseAbs().maxCoeff(), 1e-9) << "m";
 }
 
+TEST(MirrorSymmetricSettle, PushesOffASymmetricSaddleToTheFullSettlesEquilibrium) {
+  // 6 x 8 rising to 280 Pa (0.93 of levelling) first reaches a creased
+  // saddle (stability_test.cc); the push along its mode, which is odd under
+  // a mirror, settles on the displacements that keep the other mirror, and
+  // must reach the stable state the push over every DOF reaches.
+  std::vector<SettleReport> reports;
+  const auto [full, symmetric] = settle_both_ways(
+      kMedium, {Action::set_pressure(100.0), Action::set_pressure(200.0), Action::set_pressure(280.0)}, &reports);
+  ASSERT_EQ(reports.size(), 6u);
+  EXPECT_GE(reports[2].restarts, 1);
+  EXPECT_GE(reports[5].restarts, 1);
+  EXPECT_FALSE(reports[5].marginal) << "the push reached another equilibrium";
+  EXPECT_LT((full - symmetric).cwiseAbs().maxCoeff(), 1e-9) << "m";
+}
+
 TEST(MirrorSymmetricSettle, StillSeesTheModesThatBreakTheSymmetry) {
   // The 9 x 12 dome at 2 kPa has a weakly diverging shear mode, which is not
   // symmetric: the settle on the symmetric displacements converges, and the

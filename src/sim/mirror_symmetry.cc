@@ -75,6 +75,14 @@ std::vector<unsigned> mirror_characters(MirrorGroup group) {
   return {0u, 0b1010u, 0b1100u, 0b0110u};  // odd in x, odd in y, odd in both mirrors but not their product
 }
 
+MirrorClass strongest_mirror_class(const Mesh& mesh, const Eigen::Matrix3Xd& u, MirrorGroup group,
+                                   const std::vector<char>& fixed) {
+  MirrorClass best{0, -1.0};
+  for (unsigned odd : mirror_characters(group))
+    if (const double norm = mirror_projection(mesh, u, group, odd, fixed).norm(); norm > best.norm) best = {odd, norm};
+  return best;
+}
+
 MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state, double position_tolerance_m) {
   const Mesh& mesh = model.mesh();
   const std::vector<char> fixed = model.fixed_points(state);

@@ -51,6 +51,18 @@ Eigen::Matrix3Xd mirror_average(const Mesh& mesh, const Eigen::Matrix3Xd& x, Mir
 // The characters of `group` as `odd` masks: the symmetric one (0) first.
 std::vector<unsigned> mirror_characters(MirrorGroup group);
 
+// The character whose displacements hold the largest part of field u, and
+// the norm of that part (mirror_projection).
+struct MirrorClass {
+  unsigned odd = 0;
+  double norm = 0.0;
+};
+MirrorClass strongest_mirror_class(const Mesh& mesh, const Eigen::Matrix3Xd& u, MirrorGroup group,
+                                   const std::vector<char>& fixed);
+
+// The elements of `group` that a field of character `odd` is symmetric under.
+inline MirrorGroup mirror_kernel(MirrorGroup group, unsigned odd) { return {group.elements & ~odd}; }
+
 // The largest subgroup under which `state` is symmetric for `model`: the
 // clamped and pinned points and jammed cells map onto themselves, the
 // displacements from the flat grid onto their mirror images within

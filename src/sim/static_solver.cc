@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -106,6 +107,15 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
                       SettleReport& report) {
   if (system.num_dofs() != k.num_dofs() && (control != StepControl::kDisplacement || options.check_stability))
     throw std::logic_error("run_continuation: a subspace settle is the fast control without the stability check");
+  // The system the steps are solved in: `system`, or after the fast
+  // control's push off a mirror-symmetric equilibrium, the displacements
+  // that keep the part of the symmetry the pushed mode keeps (the 9 x 12
+  // dome's shear mode is odd under one mirror: half the unknowns).
+  StepSystem* active = &system;
+  ShiftedSolver* active_solver = &solver;
+  std::unique_ptr<MirrorSubspace> push_subspace;
+  std::unique_ptr<StepSystem> push_system;
+  std::unique_ptr<ShiftedSolver> push_solver;
   const Mesh& mesh = model.mesh();
   const double max_step =
       (control == StepControl::kDisplacement ? options.fast_step_fraction : options.max_step_fraction) * mesh.spacing();
@@ -154,10 +164,13 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       // at 2 kPa: 53 -> 19 ms on 2026-11-25's machine).
       constexpr double kSameMode = 0.9;
       DivergenceSearch search(k.matrix());
+      const MirrorGroup symmetry = options.mirror_symmetry && k.num_dofs() >= kMinMirrorDofs
+                                       ? mirror_symmetry_of(model, state)
+                                       : MirrorGroup{};
       // At a mirror-symmetric state, asked of the mode's symmetry class only.
       const std::optional<bool> known_in_class =
-          options.mirror_symmetry && memory.marginal_mode.size() > 0 && k.num_dofs() >= kMinMirrorDofs
-              ? still_has_in_mirror_class(mesh, k, mirror_symmetry_of(model, state), memory.marginal_mode, kSameMode)
+          memory.marginal_mode.size() > 0
+              ? still_has_in_mirror_class(mesh, k, symmetry, memory.marginal_mode, kSameMode)
               : std::nullopt;
       if (known_in_class ? *known_in_class : search.still_has(memory.marginal_mode, kSameMode)) {
         report.converged = report.marginal = true;
@@ -174,6 +187,24 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       }
       // Push off the saddle by a small fraction of h and relax again.
       Eigen::Matrix3Xd push = k.scatter(mode);
+      active = &system;
+      active_solver = &solver;
+      if (control == StepControl::kDisplacement && !symmetry.trivial()) {
+        // The mode lies in one symmetry class (K keeps them apart): pushed
+        // along its part there, the surface keeps the mirrors that class
+        // keeps, and settles on their displacements.
+        const MirrorClass mode_class = strongest_mirror_class(mesh, push, symmetry, fixed);
+        if (mode_class.norm > 0.999 * push.norm()) {
+          push = mirror_projection(mesh, push, symmetry, mode_class.odd, fixed);
+          if (const MirrorGroup kept = mirror_kernel(symmetry, mode_class.odd); !kept.trivial()) {
+            push_subspace = std::make_unique<MirrorSubspace>(mesh, k, kept);
+            push_system = std::make_unique<StepSystem>(k, *push_subspace);
+            push_solver = std::make_unique<ShiftedSolver>();
+            active = push_system.get();
+            active_solver = push_solver.get();
+          }
+        }
+      }
       Eigen::Index r = 0, c = 0;
       const double largest = push.cwiseAbs().maxCoeff(&r, &c);
       if (push(r, c) < 0) push = -push;  // a deterministic choice of side
@@ -184,40 +215,40 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       state.x += (0.05 * mesh.spacing() / largest) * push;
       unshifted_current = false;
       model.forces(state, state.x, f);
-      residual = system.gather(f);
+      residual = active->gather(f);
       mu = mu0;
       ++report.restarts;
-      halved_norm = system.force_norm(residual);
+      halved_norm = active->force_norm(residual);
       halved_at = it;
       continue;
     }
-    if (const double norm = system.force_norm(residual); norm < 0.5 * halved_norm) {
+    if (const double norm = active->force_norm(residual); norm < 0.5 * halved_norm) {
       halved_norm = norm;
       halved_at = it;
     } else if (control != StepControl::kDisplacement && pushed_at < 0 && it - halved_at > options.stall_iterations) {
       break;  // stalled: nothing to converge to
     }
     if (!unshifted_current) {
-      system.assemble(model, state, state.x);
+      active->assemble(model, state, state.x);
       unshifted_current = true;
     }
-    system.set_shift(mu);
+    active->set_shift(mu);
     Eigen::VectorXd full_step;
-    const double largest = solver.solve(system.matrix(), mu, residual, full_step)
-                               ? system.scatter(full_step).colwise().norm().maxCoeff()
+    const double largest = active_solver->solve(active->matrix(), mu, residual, full_step)
+                               ? active->scatter(full_step).colwise().norm().maxCoeff()
                                : NAN;
     if (!std::isfinite(largest)) {
       mu = std::max(4.0 * mu, mu0);
       continue;
     }
     if (control == StepControl::kCurvedModelTrust)
-      add_geodesic_acceleration(model, state, system, solver, mu, residual, full_step);
-    const Eigen::Matrix3Xd move = system.scatter(full_step);
+      add_geodesic_acceleration(model, state, *active, *active_solver, mu, residual, full_step);
+    const Eigen::Matrix3Xd move = active->scatter(full_step);
     const double scale = std::min(1.0, max_step / move.colwise().norm().maxCoeff());
     const Eigen::Matrix3Xd x_trial = state.x + scale * move;
     model.forces(state, x_trial, f_trial);
-    const Eigen::VectorXd residual_trial = system.gather(f_trial);
-    const double old_norm = system.force_norm(residual), new_norm = system.force_norm(residual_trial);
+    const Eigen::VectorXd residual_trial = active->gather(f_trial);
+    const double old_norm = active->force_norm(residual), new_norm = active->force_norm(residual_trial);
     if (control == StepControl::kDisplacement) {
       // Heading away (stiff jammed cells turned by straight strides): leave
       // it to the careful control rather than spend the budget.
@@ -236,8 +267,8 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       // whose error those springs take back at once were refused (3 x 4, all
       // jammed, 295 -> 0 Pa: 158 steps in the plain norm, 58 in this one).
       Eigen::VectorXd correction, compliance_step;
-      const bool solved = solver.solve_again(system.matrix(), mu, residual_trial, correction) &&
-                          solver.solve_again(system.matrix(), mu, full_step, compliance_step);
+      const bool solved = active_solver->solve_again(active->matrix(), mu, residual_trial, correction) &&
+                          active_solver->solve_again(active->matrix(), mu, full_step, compliance_step);
       const Eigen::VectorXd predicted = (1.0 - scale) * full_step + (scale * mu) * compliance_step;
       const double rho = solved ? (correction - predicted).norm() / std::max((full_step - predicted).norm(), 1e-300)
                                 : INFINITY;

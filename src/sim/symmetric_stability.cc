@@ -11,17 +11,11 @@ std::optional<bool> still_has_in_mirror_class(const Mesh& mesh, const StiffnessM
   std::vector<char> fixed(mesh.num_points(), 1);
   for (int p : k.free_points()) fixed[p] = 0;
   const Eigen::Matrix3Xd field = k.scatter(known);
-  unsigned best = 0;
-  double best_norm = -1.0;
-  for (unsigned odd : mirror_characters(group))
-    if (const double norm = mirror_projection(mesh, field, group, odd, fixed).norm(); norm > best_norm) {
-      best_norm = norm;
-      best = odd;
-    }
-  if (!(best_norm > overlap)) return false;
+  const MirrorClass best = strongest_mirror_class(mesh, field, group, fixed);
+  if (!(best.norm > overlap)) return false;
   // The class's block in an orthonormal basis, Q = S W^-1/2: Q^T K Q has
   // K's eigenpairs in the class, and Q^T known is known's part in it.
-  const MirrorSubspace subspace(mesh, k, group, best);
+  const MirrorSubspace subspace(mesh, k, group, best.odd);
   Eigen::SparseMatrix<double> block = subspace.pattern();
   subspace.reduce(block);
   const Eigen::VectorXd scale = subspace.weights().cwiseSqrt().cwiseInverse();
