@@ -70,10 +70,11 @@ void BM_SettleCentreJamThenStep(benchmark::State& state) {
 BENCHMARK(BM_SettleRestTo2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SettleCentreJamThenStep)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
-// The slow ones, run by name: 9 x 12 explicit, p = 10, and the 9 x 12 jammed
-// step (2 -> 1 kPa), which the static solver settles only on its curved-step
-// rescue (11.5 s CPU).
-BENCHMARK(BM_SettleRestTo2kPa)->Name("Slow/BM_SettleRestTo2kPa")->Args({9, 12, 4, 1})->Args({9, 12, 10, 0})->Unit(benchmark::kMillisecond)->Iterations(1);
+// The slow ones, run by name: 9 x 12 explicit, p = 10 (both solvers;
+// explicit Euler there takes over an hour), and the 9 x 12
+// jammed step (2 -> 1 kPa; a corner cell jammed keeps no mirror, so it
+// settles on every DOF: 113 steps, 1.3-1.6 s on 2026-12-01).
+BENCHMARK(BM_SettleRestTo2kPa)->Name("Slow/BM_SettleRestTo2kPa")->Args({9, 12, 4, 1})->Args({9, 12, 10, 0})->Args({9, 12, 10, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Name("Slow/BM_SettleOneActionAfter2kPa")->Args({9, 12, 4, 0})->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleCentreJamThenStep)->Name("Slow/BM_SettleCentreJamThenStep")->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 
