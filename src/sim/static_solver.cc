@@ -319,10 +319,9 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
 // symmetry (mirror_symmetry.h), if it has one: its equilibrium is one of
 // the full system, whose stability the full settle then checks. state.x is
 // left there if it converged, as it was otherwise; report counts the steps.
-// From a symmetric state the fast control's steps
-// on all DOFs are the same steps (K and F keep the symmetry, and the
-// residual norms are weighted to match), so where this one fails that one
-// would too, and is not run.
+// From a symmetric state the fast control's steps on all DOFs are the same
+// steps (K and F keep the symmetry, and the residual norms are weighted to
+// match), so where this one fails that one would too, and is not run.
 enum class SymmetricSettle { kNotTried, kSettled, kFailed };
 SymmetricSettle settle_mirror_symmetric(const ForceModel& model, DeviceState& state, StiffnessMatrix& k,
                                         const std::vector<char>& fixed, const StaticSolverOptions& options,
