@@ -34,6 +34,17 @@ bool pattern_symmetric(const Mesh& mesh, const DeviceState& state, const std::ve
   return true;
 }
 
+// Whether element g maps the point field u onto itself, D_g u(p) = u(g p),
+// within `tolerance`, over the points not `skipped` (null: every point).
+bool maps_onto_itself(const Mesh& mesh, const Eigen::Matrix3Xd& u, int g, double tolerance,
+                      const std::vector<char>* skipped) {
+  for (int p = 0; p < mesh.num_points(); ++p)
+    if (!(skipped && (*skipped)[p]) &&
+        (u.col(image(mesh, g, p)) - mirrored(g, u.col(p))).cwiseAbs().maxCoeff() > tolerance)
+      return false;
+  return true;
+}
+
 // The largest subgroup whose elements are all in `passing` (bit g set).
 MirrorGroup largest_subgroup(unsigned passing) {
   if ((passing & 0b1110u) == 0b1110u) return {0b1111u};
@@ -88,13 +99,9 @@ MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state
   const std::vector<char> fixed = model.fixed_points(state);
   const Eigen::Matrix3Xd u = state.x - mesh.rest_positions();
   unsigned passing = 0;
-  for (int g = 1; g <= 3; ++g) {
-    if (!pattern_symmetric(mesh, state, fixed, g)) continue;
-    bool same = true;
-    for (int p = 0; p < mesh.num_points() && same; ++p)
-      same = (u.col(image(mesh, g, p)) - mirrored(g, u.col(p))).cwiseAbs().maxCoeff() <= position_tolerance_m;
-    if (same) passing |= 1u << g;
-  }
+  for (int g = 1; g <= 3; ++g)
+    if (pattern_symmetric(mesh, state, fixed, g) && maps_onto_itself(mesh, u, g, position_tolerance_m, nullptr))
+      passing |= 1u << g;
   MirrorGroup group = largest_subgroup(passing);
   if (group.trivial()) return group;
   // The forces must be mirrored too: effects (a stiffness gradient), jam
@@ -111,13 +118,8 @@ MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state
   // spring forces about k h, which round asymmetrically at 1e-16 of that.
   const double tolerance = 1e-9 * (largest + model.params().spring_k * mesh.spacing());
   unsigned forces_passing = 0;
-  for (int g = 1; g <= 3; ++g) {
-    if (!group.has(g)) continue;
-    bool same = true;
-    for (int p = 0; p < mesh.num_points() && same; ++p)
-      same = fixed[p] || (f.col(image(mesh, g, p)) - mirrored(g, f.col(p))).cwiseAbs().maxCoeff() <= tolerance;
-    if (same) forces_passing |= 1u << g;
-  }
+  for (int g = 1; g <= 3; ++g)
+    if (group.has(g) && maps_onto_itself(mesh, f, g, tolerance, &fixed)) forces_passing |= 1u << g;
   // A subgroup of the one the positions allow is symmetric about the
   // positions averaged over the larger one as well.
   return largest_subgroup(forces_passing);

@@ -164,13 +164,18 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       // at 2 kPa: 53 -> 19 ms on 2026-11-25's machine).
       constexpr double kSameMode = 0.9;
       DivergenceSearch search(k.matrix());
-      const MirrorGroup symmetry = options.mirror_symmetry && k.num_dofs() >= kMinMirrorDofs
-                                       ? mirror_symmetry_of(model, state)
-                                       : MirrorGroup{};
+      // The state's mirror symmetry, found when a question needs it.
+      std::optional<MirrorGroup> found_symmetry;
+      auto symmetry = [&] {
+        if (!found_symmetry)
+          found_symmetry = options.mirror_symmetry && k.num_dofs() >= kMinMirrorDofs ? mirror_symmetry_of(model, state)
+                                                                                      : MirrorGroup{};
+        return *found_symmetry;
+      };
       // At a mirror-symmetric state, asked of the mode's symmetry class only.
       const std::optional<bool> known_in_class =
           memory.marginal_mode.size() > 0
-              ? still_has_in_mirror_class(mesh, k, symmetry, memory.marginal_mode, kSameMode)
+              ? still_has_in_mirror_class(mesh, k, symmetry(), memory.marginal_mode, kSameMode)
               : std::nullopt;
       if (known_in_class ? *known_in_class : search.still_has(memory.marginal_mode, kSameMode)) {
         report.converged = report.marginal = true;
@@ -189,14 +194,14 @@ void run_continuation(const ForceModel& model, DeviceState& state, StiffnessMatr
       Eigen::Matrix3Xd push = k.scatter(mode);
       active = &system;
       active_solver = &solver;
-      if (control == StepControl::kDisplacement && !symmetry.trivial()) {
+      if (control == StepControl::kDisplacement && !symmetry().trivial()) {
         // The mode lies in one symmetry class (K keeps them apart): pushed
         // along its part there, the surface keeps the mirrors that class
         // keeps, and settles on their displacements.
-        const MirrorClass mode_class = strongest_mirror_class(mesh, push, symmetry, fixed);
+        const MirrorClass mode_class = strongest_mirror_class(mesh, push, symmetry(), fixed);
         if (mode_class.norm > 0.999 * push.norm()) {
-          push = mirror_projection(mesh, push, symmetry, mode_class.odd, fixed);
-          if (const MirrorGroup kept = mirror_kernel(symmetry, mode_class.odd); !kept.trivial()) {
+          push = mirror_projection(mesh, push, symmetry(), mode_class.odd, fixed);
+          if (const MirrorGroup kept = mirror_kernel(symmetry(), mode_class.odd); !kept.trivial()) {
             push_subspace = std::make_unique<MirrorSubspace>(mesh, k, kept);
             push_system = std::make_unique<StepSystem>(k, *push_subspace);
             push_solver = std::make_unique<ShiftedSolver>();
