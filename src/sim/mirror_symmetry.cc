@@ -40,7 +40,7 @@ bool maps_onto_itself(const Mesh& mesh, const Eigen::Matrix3Xd& u, int g, double
                       const std::vector<char>* skipped) {
   for (int p = 0; p < mesh.num_points(); ++p)
     if (!(skipped && (*skipped)[p]) &&
-        (u.col(image(mesh, g, p)) - mirrored(g, u.col(p))).cwiseAbs().maxCoeff() > tolerance)
+        !((u.col(image(mesh, g, p)) - mirrored(g, u.col(p))).cwiseAbs().maxCoeff() <= tolerance))
       return false;
   return true;
 }
