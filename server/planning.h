@@ -17,7 +17,7 @@ namespace hj::server {
 struct PlanningInput {
   ArrayConfig array;
   HeightMap goal;
-  double max_height_mm = 30.0;
+  double max_height_mm = 0.0;  // 0: the array's default relief
   std::string planner = "algorithm2";
 };
 

@@ -4,6 +4,7 @@
 
 #include "calib/step_json.h"
 #include "json_log.h"
+#include "plan/refused_json.h"
 #include "planning.h"
 #include "request_context.h"
 #include "service_error.h"
@@ -29,6 +30,7 @@ std::shared_ptr<const v1::PlanResult> result_to_proto(const Mesh& mesh, const Pl
     steps.push_back(action_to_step_json(a));
   }
   result->set_steps_json(steps.dump());
+  result->set_refused_json(refused_to_json(out.result.refused).dump());
   snapshot_to_proto(mesh, out.result.final_state, int(out.result.steps.size()), result->mutable_predicted());
   for (int i = 0; i < out.goal_mm.rows(); ++i)
     for (int j = 0; j < out.goal_mm.cols(); ++j) result->add_goal_heights_mm(out.goal_mm(i, j));

@@ -81,9 +81,9 @@ ImportOptions import_options_from_proto(const v1::GoalOptions& options, const Se
 
 double max_height_from_proto(const v1::GoalOptions& options) {
   const double h = options.max_height_mm();
-  if (h == 0.0) return kDefaultMaxHeightMm;
+  if (h == 0.0) return 0.0;  // the array's default relief (default_relief_mm)
   if (!(h > 0.0) || !std::isfinite(h))
-    throw std::invalid_argument("goal.options.max_height_mm must be positive and finite (0 = 30 mm)");
+    throw std::invalid_argument("goal.options.max_height_mm must be positive and finite (0 = the array's default relief)");
   return h;
 }
 

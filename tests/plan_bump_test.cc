@@ -34,7 +34,7 @@ HeightMap centred_gaussian(int pixels, double sd_fraction) {
 double planned_correlation(const HeightMap& goal, int cells_per_side) {
   const ArrayGeometry geometry{cells_per_side, cells_per_side, 0.038, 4};
   const Mesh mesh(geometry);
-  const PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry), resample_to_mesh(goal, mesh), {}};
+  const PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry), resample_to_mesh(goal, mesh, 30.0), {}, {}};
   const PlanResult plan = make_planner("from-above")->plan(request);
   // Mesh rows run along +y; the image's row 0 is its top.
   const Correlation c = correlate_with_goal(goal.z, (point_heights(mesh, plan.final_state.x) * 1000.0).colwise().reverse());
@@ -57,7 +57,7 @@ TEST(FromAbove, PinsLandOnTheirGoalsAndTheStepsReplay) {
   // net at levelling, where the height goes as the cube root of the net load
   // and even the smallest step (1 Pa) can move a node by more than the
   // tolerance (with sd a tenth, goals of 2.2 mm are pinned at 1.5 mm).
-  const PlanRequest request{geometry, params, resample_to_mesh(centred_gaussian(64, 1.0 / 6.0), mesh), {}};
+  const PlanRequest request{geometry, params, resample_to_mesh(centred_gaussian(64, 1.0 / 6.0), mesh, 30.0), {}, {}};
   const PlanResult plan = make_planner("from-above")->plan(request);
   Simulator replay(geometry, params);
   for (const Action& a : plan.steps) {

@@ -27,7 +27,7 @@ Eigen::MatrixXd centred_bump(const Mesh& mesh) {
 TEST(Algorithm2Refined, BeatsAlgorithm2OnABumpAndItsStepsReplay) {
   const SurfaceParameters params = SurfaceParameters::paper_defaults(kTwoByTwo);
   const Mesh mesh(kTwoByTwo);
-  const PlanRequest request{kTwoByTwo, params, centred_bump(mesh), {}};
+  const PlanRequest request{kTwoByTwo, params, centred_bump(mesh), {}, {}};
   const PlanResult plain = make_planner("algorithm2")->plan(request);
   const PlanResult refined = make_planner("algorithm2-refined")->plan(request);
   const auto r = [&](const DeviceState& s) { return *correlate(request.goal_mm, point_heights(mesh, s.x) * 1000.0).value; };

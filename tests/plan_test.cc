@@ -20,7 +20,7 @@ TEST(Algorithm2, MatchesAGoalTheDeviceMade) {
   for (const Action& a : {Action::set_pressure(600), Action::set_pressure(310), Action::jam(0, 1), Action::pin(1, 2),
                           Action::set_pressure(1500)})
     device.apply(a);
-  const PlanRequest request{kPaper, params, heights_mm(device.mesh(), device.state()), {}};
+  const PlanRequest request{kPaper, params, heights_mm(device.mesh(), device.state()), {}, {}};
   const PlanResult plan = make_planner("algorithm2")->plan(request);
   const Correlation c = correlate(request.goal_mm, heights_mm(device.mesh(), plan.final_state));
   ASSERT_TRUE(c.value.has_value()) << c.undefined_reason;

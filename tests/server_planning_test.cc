@@ -95,7 +95,7 @@ TEST(ServerPlanning, StreamsProgressSnapshotsAndTheLibrarysResult) {
   const ArrayGeometry g{3, 4, 0.038, 2};
   const Mesh mesh(g);
   const PlanResult plan = make_planner("algorithm2")->plan(
-      {g, SurfaceParameters::paper_defaults(g), resample_to_mesh(goal, mesh, kDefaultMaxHeightMm), {}});
+      {g, SurfaceParameters::paper_defaults(g), resample_to_mesh(goal, mesh, default_relief_mm(g)), {}});
   const Eigen::MatrixXd predicted = point_heights(mesh, plan.final_state.x) * 1000.0;
   const Correlation expected = correlate_with_goal(goal.z, predicted.colwise().reverse());
   ASSERT_TRUE(expected.value.has_value());

@@ -333,9 +333,19 @@ TEST(ShapesResample, ImageTopIsHighMeshRows) {
   goal.z = Eigen::MatrixXd::Zero(30, 40);
   goal.z.topRows(5).setConstant(1.0);  // the top (north) edge is high
   const Eigen::MatrixXd h = resample_to_mesh(goal, mesh);
-  EXPECT_EQ(h.row(12).minCoeff(), kDefaultMaxHeightMm);
+  EXPECT_EQ(h.row(12).minCoeff(), default_relief_mm(mesh.geometry()));
   EXPECT_EQ(h.row(0).maxCoeff(), 0.0);
   EXPECT_GT(h.row(11).mean(), h.row(1).mean());
+}
+
+TEST(ShapesResample, DefaultReliefScalesWithTheArraysShorterSide) {
+  // The paper's convention: a 9 x 12 array gets a goal three times as tall as 3 x 4.
+  EXPECT_DOUBLE_EQ(default_relief_mm({3, 4, 0.038, 4}), 30.0);
+  EXPECT_DOUBLE_EQ(default_relief_mm({9, 12, 0.038, 4}), 90.0);
+  EXPECT_DOUBLE_EQ(default_relief_mm({12, 9, 0.038, 4}), 90.0);
+  EXPECT_DOUBLE_EQ(default_relief_mm({3, 4, 0.076, 4}), 60.0);
+  EXPECT_DOUBLE_EQ(relief_or_default_mm(25.0, {9, 12, 0.038, 4}), 25.0);
+  EXPECT_DOUBLE_EQ(relief_or_default_mm(0.0, {1, 2, 0.038, 4}), 10.0);
 }
 
 TEST(ShapesResample, NoDataTakesNearestValidValue) {

@@ -32,10 +32,17 @@ SweepGoal bump_goal(const std::string& name, double width) {
 }
 
 TEST(Sweep, ParsesSizes) {
+  // The paper's Table 1: 16 sizes, 1x2 (2 cells) to 9x12 (108 cells).
   const auto paper = parse_array_sizes("paper");
-  ASSERT_EQ(paper.size(), 5u);
+  ASSERT_EQ(paper.size(), 16u);
+  EXPECT_EQ(paper.front().rows * paper.front().cols, 2);
   EXPECT_EQ(paper.back().rows, 9);
   EXPECT_EQ(paper.back().cols, 12);
+  EXPECT_EQ(parse_array_sizes("quick").size(), 5u);
+  EXPECT_EQ(table2_alphas().size(), 5u);
+  EXPECT_DOUBLE_EQ(table2_alphas()[1], 0.125);
+  EXPECT_EQ(paper_table2_r2(0.125), 0.7583);
+  EXPECT_FALSE(paper_table2_r2(1.0 / 3.0));
   const auto two = parse_array_sizes("2x3,10X1");
   ASSERT_EQ(two.size(), 2u);
   EXPECT_EQ(two[0].cols, 3);

@@ -14,6 +14,7 @@
 #include "metrics/correlation.h"
 #include "metrics/laplace_predictor.h"
 #include "plan/planner.h"
+#include "plan/refused_json.h"
 #include "progress.h"
 #include "shapes/geo_region.h"
 #include "shapes/goal_importer.h"
@@ -31,13 +32,16 @@ constexpr const char* kPlanUsage =
     "                      [--up-axis [-]x|y|z] [--view-resolution N]\n"
     "                      [--region-lonlat lon0,lat0,lon1,lat1] [--encoding E] [--no-sidecar]\n"
     "Plans the actions that make the display show GOAL (a height image: CSV, PNG,\n"
-    "TIFF or GeoTIFF, SRTM .hgt; or a mesh: STL, OBJ, PLY, glTF/GLB, 3MF, seen from above) and writes DIR/plan.json (steps in the session format, correlation,\n"
-    "Laplace mean), DIR/predicted.csv and DIR/goal.csv (mm per mesh point, row i\n"
-    "along +y) and DIR/compare.png.\n"
+    "TIFF or GeoTIFF, SRTM .hgt; or a mesh: STL, OBJ, PLY, glTF/GLB, 3MF, seen from\n"
+    "above) and writes DIR/plan.json (steps in the session format, correlation,\n"
+    "Laplace mean, and the actions refused as dead ends with their reasons),\n"
+    "DIR/predicted.csv and DIR/goal.csv (mm per mesh point, row i along +y),\n"
+    "DIR/predicted_x.csv and predicted_y.csv (in-plane positions, mm) and DIR/compare.png.\n"
     "  --rows R, --cols C    array size in cells (38 mm cells)\n"
     "  --segments P          segments per cell edge (default 4)\n"
     "  --planner NAME        default algorithm2\n"
-    "  --max-height-mm H     goal height range on the display (default 30 mm)\n"
+    "  --max-height-mm H     goal height range on the display (default: 10 mm per cell\n"
+    "                        of the array's shorter side, e.g. 30 mm at 3 x 4, 90 mm at 9 x 12)\n"
     "  --region x0,y0,x1,y1  zoom: pixels, or fractions of the image if all <= 1\n"
     "  --hue                 colour topographic map: red-orange high, blue-purple low\n"
     "  --json                print the summary as JSON\n"
@@ -51,7 +55,7 @@ constexpr const char* kPlanUsage =
 struct PlanArgs {
   std::string goal, out, planner = "algorithm2", region, region_lonlat;
   int rows = 0, cols = 0, segments = 4;
-  double max_height_mm = kDefaultMaxHeightMm;
+  double max_height_mm = 0.0;  // 0: the array's default relief (default_relief_mm)
   bool hue = false, json = false;
   ImportOptions import;
 };
@@ -110,8 +114,9 @@ int plan(const PlanArgs& args) {
   if (!args.region_lonlat.empty()) goal = crop_lonlat(goal, parse_lonlat_box(args.region_lonlat));
   const ArrayGeometry geometry{args.rows, args.cols, 0.038, args.segments};
   const Mesh mesh(geometry);
-  PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),
-                      resample_to_mesh(goal, mesh, args.max_height_mm), {}};
+  const double relief_mm = relief_or_default_mm(args.max_height_mm, geometry);
+  PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry), resample_to_mesh(goal, mesh, relief_mm), {},
+                      goal.z};
   const auto planner = make_planner(args.planner);
 
   ProgressLine progress("plan " + std::filesystem::path(args.goal).filename().string());
@@ -129,6 +134,9 @@ int plan(const PlanArgs& args) {
   const std::filesystem::path out(args.out);
   std::filesystem::create_directories(out);
   write_frame_csv(out / "predicted.csv", predicted_mm);
+  // The in-plane positions too, so a capture is compared where the points moved (remote submit --capture).
+  write_frame_csv(out / "predicted_x.csv", point_coordinates(mesh, result.final_state.x, 0) * 1000.0);
+  write_frame_csv(out / "predicted_y.csv", point_coordinates(mesh, result.final_state.x, 1) * 1000.0);
   write_frame_csv(out / "goal.csv", request.goal_mm);
   write_compare_png(out / "compare.png", mesh, request.goal_mm, predicted_mm);
   nlohmann::json steps = nlohmann::json::array();
@@ -141,21 +149,27 @@ int plan(const PlanArgs& args) {
       {"parameters",
        {{"mass_kg", p.mass_kg}, {"spring_k", p.spring_k}, {"kappa_jam", p.kappa_jam}, {"max_pressure_kpa", p.max_pressure_pa / 1000.0}}},
       {"planner", planner->name()},
-      {"max_height_mm", args.max_height_mm},
+      {"max_height_mm", relief_mm},
       {"steps", steps},
       {"correlation", corr.value ? nlohmann::json(*corr.value) : nlohmann::json(nullptr)},
       {"laplace_mean", laplace}};
   if (!corr.value) doc["correlation_undefined"] = corr.undefined_reason;
+  if (!result.note.empty()) doc["planner_note"] = result.note;
+  doc["refused"] = refused_to_json(result.refused);
   std::ofstream(out / "plan.json") << doc.dump(1) << "\n";
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (args.json) {
     nlohmann::json summary = {{"goal", args.goal}, {"rows", args.rows}, {"cols", args.cols},
-                              {"steps", result.steps.size()}, {"correlation", doc["correlation"]},
+                              {"steps", result.steps.size()}, {"refused", result.refused.size()},
+                              {"correlation", doc["correlation"]},
                               {"laplace_mean", laplace}, {"seconds", seconds}, {"out", args.out}};
     std::cout << summary.dump() << "\n";
   } else {
-    std::printf("%s on %d x %d: %zu steps, correlation %s, Laplace mean %.3f, written to %s in %.2f s\n",
+    std::printf("%s on %d x %d: %zu steps%s, correlation %s, Laplace mean %.3f, written to %s in %.2f s\n",
                 args.goal.c_str(), args.rows, args.cols, result.steps.size(),
+                result.refused.empty() ? ""
+                                       : (" (" + std::to_string(result.refused.size()) +
+                                          " actions refused as dead ends, see plan.json)").c_str(),
                 corr.value ? std::to_string(*corr.value).substr(0, 6).c_str() : ("undefined (" + corr.undefined_reason + ")").c_str(),
                 laplace, args.out.c_str(), seconds);
   }

@@ -137,6 +137,7 @@ int remote_plan(const RemotePlanArgs& args) {
       {"cached", result.cached()}};
   if (args.goal.max_height_mm > 0) doc["max_height_mm"] = args.goal.max_height_mm;
   if (!result.has_correlation()) doc["correlation_undefined"] = result.correlation_undefined();
+  doc["refused"] = result.refused_json().empty() ? nlohmann::json::array() : nlohmann::json::parse(result.refused_json());
   std::ofstream(out / "plan.json") << doc.dump(1) << "\n";
 
   if (args.json) {

@@ -28,18 +28,19 @@ constexpr const char* kSweepUsage =
     "Plans every GOAL at every array size, the plans in parallel (one thread each),\n"
     "and writes DIR/sweep.csv (goal, rows, cols, cells, correlation, the Laplace\n"
     "mean of the goal as resampled to the mesh for each alpha_L, steps, seconds,\n"
-    "status, detail), DIR/table2.csv (line fit of correlation against the Laplace\n"
-    "mean per alpha_L, also printed), DIR/fig11_correlation_vs_cells.png and\n"
-    "DIR/fig13_correlation_vs_laplace.png (alpha_L = 1/3, Eq. 14).\n"
-    "  --sizes S           \"paper\" (default: 2x2,3x4,4x6,6x8,9x12) or a list such as 2x2,3x4\n"
+    "refused, relief_mm, status, detail), DIR/table2.csv (line fit of correlation\n"
+    "against the Laplace mean per alpha_L beside the paper's r^2, also printed),\n"
+    "DIR/fig11_correlation_vs_cells.png and DIR/fig13_correlation_vs_laplace.png\n"
+    "(at the alpha_L whose fit is best).\n"
+    "  --sizes S           \"paper\" (default: the 16 sizes of Table 1, 1x2 .. 9x12), \"quick\"\n"
+    "                      (2x2,3x4,4x6,6x8,9x12) or a list such as 2x2,3x4\n"
     "  --planner NAME      default algorithm2\n"
     "  --jobs N            threads (default: one per core)\n"
     "  --budget-s S        per plan; a plan past it is stopped at its next action and\n"
     "                      recorded as over-budget (default 120)\n"
-    "  --fallback-steps N  explicit-fallback steps one settle may take (default 200000;\n"
-    "                      0: the simulator's 2000000); bounds how far a plan overruns its budget\n"
     "  --segments P        segments per cell edge (default 4)\n"
-    "  --max-height-mm H   goal height range on the display (default 30 mm)\n"
+    "  --max-height-mm H   goal height range on the display (default: 10 mm per cell\n"
+    "                      of each array's shorter side)\n"
     "  --up-axis A         meshes' up axis (default: each mesh's sidecar JSON \"up_axis\", else z)\n"
     "  --view-resolution N pixels of a mesh's top view along its longer side (default 256)\n"
     "  --encoding E        PNG pixels: grey (default), terrain-rgb or terrarium\n"
@@ -74,7 +75,7 @@ SweepArgs parse_sweep_args(const std::vector<std::string>& args) {
     else if (a == "--budget-s") {
       out.options.budget_s = parse_number(a, value());
       if (!(out.options.budget_s > 0.0)) throw std::invalid_argument("--budget-s needs a positive number of seconds");
-    } else if (a == "--fallback-steps") out.options.fallback_max_steps = parse_int(a, value(), 0, 100'000'000);
+    }
     else if (a == "--segments") out.options.segments = parse_int(a, value(), 2, 1000);
     else if (a == "--max-height-mm") {
       out.options.max_height_mm = parse_number(a, value());
@@ -128,7 +129,7 @@ std::string csv_field(const std::string& s) {
 }
 
 std::string alpha_name(double a) {
-  // Column-name friendly: 0, 1/6, 1/3, 1/2, 1 -> a0, a1_6, a1_3, a1_2, a1; others by value.
+  // Column-name friendly: 0, 1/8, 1/4, 1/2, 1 -> a0, a1_8, a1_4, a1_2, a1; others by value.
   for (int d : {1, 2, 3, 4, 6, 8})
     for (int n = 0; n <= d; ++n)
       if (std::abs(a - double(n) / d) < 1e-12) return n == 0 ? "a0" : n == d ? "a1" : "a" + std::to_string(n) + "_" + std::to_string(d);
@@ -164,7 +165,7 @@ int sweep(const SweepArgs& args) {
     std::ofstream csv(out / "sweep.csv");
     csv << "goal,rows,cols,cells,correlation";
     for (double a : alphas) csv << ",laplace_mean_" << alpha_name(a);
-    csv << ",steps,seconds,status,detail\n" << std::setprecision(6);
+    csv << ",steps,refused,relief_mm,seconds,status,detail\n" << std::setprecision(6);
     for (const auto& r : rows) {
       csv << csv_field(r.goal) << "," << r.rows << "," << r.cols << "," << r.cells() << ",";
       if (r.correlation) csv << *r.correlation;
@@ -172,17 +173,20 @@ int sweep(const SweepArgs& args) {
         csv << ",";
         if (k < r.laplace_mean.size()) csv << r.laplace_mean[k];
       }
-      csv << "," << r.steps << "," << r.seconds << "," << r.status << "," << csv_field(r.detail) << "\n";
+      csv << "," << r.steps << "," << r.refused << "," << r.relief_mm << "," << r.seconds << "," << r.status << ","
+          << csv_field(r.detail) << "\n";
     }
   }
   const auto t2 = table2(rows, alphas);
   {
     std::ofstream csv(out / "table2.csv");
-    csv << "alpha_l,slope,intercept,r2,n\n" << std::setprecision(6);
+    csv << "alpha_l,slope,intercept,r2,n,paper_r2\n" << std::setprecision(6);
     for (const auto& t : t2) {
       csv << t.alpha << ",";
       if (t.fit) csv << t.fit->slope << "," << t.fit->intercept << "," << t.fit->r2 << "," << t.fit->n;
       else csv << ",,,0";
+      csv << ",";
+      if (const auto paper = paper_table2_r2(t.alpha)) csv << *paper;
       csv << "\n";
     }
   }
@@ -201,10 +205,11 @@ int sweep(const SweepArgs& args) {
     }
   }
   write_plot_png(out / "fig11_correlation_vs_cells.png", fig11);
-  // Fig. 13: correlation against the Laplace mean (alpha_L = 1/3), with the fit.
+  // Fig. 13: correlation against the Laplace mean at the alpha_L whose line
+  // fit is best (highest r^2), with the fit.
   std::size_t a13 = 0;
-  for (std::size_t k = 0; k < alphas.size(); ++k)
-    if (std::abs(alphas[k] - 1.0 / 3.0) < 1e-12) a13 = k;
+  for (std::size_t k = 0; k < alphas.size() && k < t2.size(); ++k)
+    if (t2[k].fit && (!t2[a13].fit || t2[k].fit->r2 > t2[a13].fit->r2)) a13 = k;
   Plot fig13;
   fig13.title = "Correlation against the Laplace mean (cf. Fig. 13)";
   fig13.x_label = "Laplace mean of the goal on the mesh";
@@ -234,13 +239,16 @@ int sweep(const SweepArgs& args) {
                 r.correlation ? std::to_string(*r.correlation).substr(0, 6).c_str() : "-",
                 a13 < r.laplace_mean.size() ? r.laplace_mean[a13] : NAN, r.seconds, r.status.c_str(),
                 r.detail.empty() ? "" : (" (" + r.detail.substr(0, 80) + ")").c_str());
-  std::printf("\nTable 2 analogue: correlation = slope * Laplace mean + intercept\n%-8s %9s %10s %7s %4s\n", "alpha_L",
-              "slope", "intercept", "r^2", "n");
+  std::printf("\nTable 2 analogue: correlation = slope * Laplace mean + intercept\n%-8s %9s %10s %7s %4s %10s\n",
+              "alpha_L", "slope", "intercept", "r^2", "n", "paper r^2");
   for (const auto& t : t2) {
+    const std::optional<double> paper = paper_table2_r2(t.alpha);
+    const std::string paper_text = paper ? std::to_string(*paper).substr(0, 6) : "-";
     if (t.fit)
-      std::printf("%-8.4g %9.4f %10.4f %7.4f %4d\n", t.alpha, t.fit->slope, t.fit->intercept, t.fit->r2, t.fit->n);
+      std::printf("%-8.4g %9.4f %10.4f %7.4f %4d %10s\n", t.alpha, t.fit->slope, t.fit->intercept, t.fit->r2, t.fit->n,
+                  paper_text.c_str());
     else
-      std::printf("%-8.4g %9s %10s %7s %4d\n", t.alpha, "-", "-", "-", 0);
+      std::printf("%-8.4g %9s %10s %7s %4d %10s\n", t.alpha, "-", "-", "-", 0, paper_text.c_str());
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("\n%zu plans in %.1f s; written to %s\n", rows.size(), seconds, args.out.c_str());

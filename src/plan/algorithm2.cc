@@ -24,35 +24,27 @@ PlanResult Algorithm2::plan(const PlanRequest& request, const PlanCallbacks& cal
   const double p_max = plan_max_pressure(options_.max_pressure_pa, request.params);
 
   // The goal as a surface on the mesh, for its node heights and curvatures.
-  Eigen::Matrix3Xd goal_x = mesh.rest_positions();
-  for (int i = 0; i < mesh.point_rows(); ++i)
-    for (int j = 0; j < mesh.point_cols(); ++j) goal_x(2, mesh.index(i, j)) = request.goal_mm(i, j) / 1000.0;
+  const Eigen::Matrix3Xd goal_x = goal_positions(mesh, request.goal_mm);
   const Eigen::MatrixXd goal_curvature = cell_curvatures(mesh, goal_x);
 
+  // A pressure step with no equilibrium is refused (result.refused) and the
+  // next increment tried from the same state; after kMaxRefusedInARow the
+  // rise ends there (the larger steps from the same jams fold the same way:
+  // the 9 x 12 volcano refuses every one from 0.25 to 3.45 kPa).
+  constexpr int kMaxRefusedInARow = 2;
   PlanResult result;
-  auto apply = [&](const Action& action) { apply_planned(sim, action, result, callbacks); };
   const int increments = static_cast<int>(std::ceil(p_max / options_.pressure_increment_pa - 1e-9));
-  for (int n = 1; n <= increments; ++n) {
+  int refused_in_a_row = 0;
+  for (int n = 1; n <= increments && refused_in_a_row < kMaxRefusedInARow; ++n) {
     const double pressure = std::min(n * options_.pressure_increment_pa, p_max);
-    apply(Action::set_pressure(pressure));
-    bool all_done = true;
-    for (int a = 1; a < mesh.rows(); ++a)
-      for (int b = 1; b < mesh.cols(); ++b) {
-        if (sim.state().pinned(mesh, a, b)) continue;
-        const int point = mesh.node_point(a, b);
-        if (sim.state().x(2, point) >= goal_x(2, point))
-          apply(Action::pin(a, b));
-        else
-          all_done = false;
-      }
-    for (int r = 0; r < mesh.rows(); ++r)
-      for (int c = 0; c < mesh.cols(); ++c) {
-        if (sim.state().jammed(mesh, r, c)) continue;
-        if (cell_curvature(mesh, sim.state().x, r, c) >= goal_curvature(r, c))
-          apply(Action::jam(r, c));
-        else
-          all_done = false;
-      }
+    if (!try_planned(sim, Action::set_pressure(pressure), result, callbacks)) {
+      ++refused_in_a_row;
+      continue;
+    }
+    refused_in_a_row = 0;
+    const bool nodes_done = pin_reached_nodes(sim, goal_x, Reach::kFromBelow, result, callbacks);
+    const bool cells_done = jam_reached_cells(sim, goal_curvature, Reach::kFromBelow, result, callbacks);
+    const bool all_done = nodes_done && cells_done;
     if (callbacks.progress)
       callbacks.progress(double(n) / increments, "pressure " + std::to_string(pressure / 1000.0).substr(0, 5) + " kPa");
     if (all_done) break;

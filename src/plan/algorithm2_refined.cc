@@ -32,21 +32,18 @@ constexpr double kEndPressureFactors[] = {4.0, 3.0, 2.0, 1.5, 1.25, 1.1, 1.02};
 // levelling pressure.
 PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_max,
                        const PlanCallbacks& callbacks) {
-  const std::function<bool()>& cancelled = callbacks.cancelled;
   Simulator sim(request.geometry, request.params, simulator_options(request, callbacks));
   const Mesh& mesh = sim.mesh();
   const double p_level = request.params.levelling_pressure_pa(mesh);
-  Eigen::Matrix3Xd goal_x = mesh.rest_positions();
-  for (int i = 0; i < mesh.point_rows(); ++i)
-    for (int j = 0; j < mesh.point_cols(); ++j) goal_x(2, mesh.index(i, j)) = v.scale * request.goal_mm(i, j) / 1000.0;
+  const Eigen::Matrix3Xd goal_x = goal_positions(mesh, request.goal_mm, v.scale);
   const Eigen::MatrixXd goal_curvature = cell_curvatures(mesh, goal_x);
 
+  // A variant streams no snapshots (only the chosen one is sent); a pressure
+  // step with no equilibrium is refused and handled as an overshoot.
+  PlanCallbacks quiet;
+  quiet.cancelled = callbacks.cancelled;
   PlanResult result;
-  auto apply = [&](const Action& action) {
-    if (cancelled && cancelled()) throw PlanCancelled();
-    sim.apply(action);
-    result.steps.push_back(action);
-  };
+  auto apply = [&](double pressure_pa) { return try_planned(sim, Action::set_pressure(pressure_pa), result, quiet); };
   const double tolerance_m =
       std::max(kPinToleranceMm, kPinToleranceFraction * v.scale * (request.goal_mm.maxCoeff() - request.goal_mm.minCoeff())) /
       1000.0;
@@ -61,30 +58,22 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
   double previous = 0.0, step = v.increment_pa;
   while (previous < p_max) {
     const double pressure = std::min(previous + step, p_max);
-    apply(Action::set_pressure(pressure));
-    if (v.bisect_pins && step > kMinStepPa && overshoots()) {
-      apply(Action::set_pressure(previous));
+    if (!apply(pressure)) {
+      if (step <= kMinStepPa) break;
+      step /= 2.0;
+      continue;
+    }
+    if (v.bisect_pins && step > kMinStepPa && overshoots() && apply(previous)) {
       step /= 2.0;
       continue;
     }
     previous = pressure;
     const std::size_t steps_before = result.steps.size();
-    bool all_done = true;
-    for (int a = 1; a < mesh.rows(); ++a)
-      for (int b = 1; b < mesh.cols(); ++b) {
-        if (sim.state().pinned(mesh, a, b)) continue;
-        const int point = mesh.node_point(a, b);
-        if (sim.state().x(2, point) >= goal_x(2, point)) apply(Action::pin(a, b));
-        else all_done = false;
-      }
+    const bool nodes_done = pin_reached_nodes(sim, goal_x, Reach::kFromBelow, result, quiet);
     const bool may_jam = v.jam_below_levelling || pressure >= p_level;
-    for (int r = 0; r < mesh.rows(); ++r)
-      for (int c = 0; c < mesh.cols(); ++c) {
-        if (sim.state().jammed(mesh, r, c)) continue;
-        if (may_jam && cell_curvature(mesh, sim.state().x, r, c) >= goal_curvature(r, c)) apply(Action::jam(r, c));
-        else all_done = false;
-      }
-    if (all_done) break;
+    const bool cells_done = may_jam ? jam_reached_cells(sim, goal_curvature, Reach::kFromBelow, result, quiet)
+                                    : every_cell_jammed(mesh, sim.state());
+    if (nodes_done && cells_done) break;
     if (result.steps.size() > steps_before + 1) step = v.increment_pa;  // pinned or jammed: full steps again
   }
   // End pressure: with the pins and jams set, lower pressure lets the cells
@@ -97,10 +86,10 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
   for (double f : kEndPressureFactors) {
     const double p = f * p_level;
     if (p >= sim.state().pressure_pa || p > p_max) continue;
-    apply(Action::set_pressure(p));
+    if (!apply(p)) continue;
     if (const double r = score(); r > best_r) best_r = r, best_pressure = p;
   }
-  if (sim.state().pressure_pa != best_pressure) apply(Action::set_pressure(best_pressure));
+  if (sim.state().pressure_pa != best_pressure) apply(best_pressure);
   result.final_state = sim.state();
   return result;
 }

@@ -45,17 +45,17 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
   const double p_floor = 0.0;
 
   // The goal as a surface on the mesh, for its node heights and curvatures.
-  Eigen::Matrix3Xd goal_x = mesh.rest_positions();
-  for (int i = 0; i < mesh.point_rows(); ++i)
-    for (int j = 0; j < mesh.point_cols(); ++j) goal_x(2, mesh.index(i, j)) = request.goal_mm(i, j) / 1000.0;
+  const Eigen::Matrix3Xd goal_x = goal_positions(mesh, request.goal_mm);
   const Eigen::MatrixXd goal_curvature = cell_curvatures(mesh, goal_x);
   const double tolerance_m =
       std::max(options_.pin_tolerance_mm,
                options_.pin_tolerance_fraction * (request.goal_mm.maxCoeff() - request.goal_mm.minCoeff())) /
       1000.0;
 
+  // Every pressure step goes through try_planned: one with no equilibrium
+  // is refused (result.refused) and the plan goes on from the state it had.
   PlanResult result;
-  auto apply = [&](const Action& action) { apply_planned(sim, action, result, callbacks); };
+  auto apply = [&](double pressure_pa) { return try_planned(sim, Action::set_pressure(pressure_pa), result, callbacks); };
   auto progress = [&](double fraction, double pressure_pa, const char* phase) {
     if (!callbacks.progress) return;
     char what[64];
@@ -74,40 +74,36 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
   // Up: double the pressure from twice levelling until every node is at or
   // above its goal (the first step crosses levelling, from the mirror image
   // of the sag, see sim/levelling_crossing.h).
-  double pressure = p_level;
+  double target = p_level;
   do {
-    pressure = std::min(2.0 * pressure, p_max);
-    apply(Action::set_pressure(pressure));
-    progress(0.1, pressure, "raising");
-  } while (pressure < p_max && free_node_height_error([](double dz) { return dz < 0.0; }));
+    target = std::min(2.0 * target, p_max);
+    apply(target);
+    progress(0.1, target, "raising");
+  } while (target < p_max && free_node_height_error([](double dz) { return dz < 0.0; }));
 
-  // Down: pin nodes and jam cells as they come down to their goals.
+  // Down: pin nodes and jam cells as they come down to their goals. A step
+  // with no equilibrium, or one that takes a free node too far below its
+  // goal, is halved (down to min_step_pa; a refused one that small ends the descent).
+  double pressure = sim.state().pressure_pa;
   const double top = pressure;
   double step = options_.decrement_pa;
   while (pressure > p_floor) {
     const double next = std::max(pressure - step, p_floor);
-    apply(Action::set_pressure(next));
-    if (step > options_.min_step_pa && free_node_height_error([&](double dz) { return dz < -tolerance_m; })) {
-      apply(Action::set_pressure(pressure));  // back off, halve the step
+    if (!apply(next)) {
+      if (step <= options_.min_step_pa) break;
+      step /= 2.0;
+      continue;
+    }
+    if (step > options_.min_step_pa && free_node_height_error([&](double dz) { return dz < -tolerance_m; }) &&
+        apply(pressure)) {  // back off, halve the step
       step /= 2.0;
       continue;
     }
     pressure = next;
     const std::size_t steps_before = result.steps.size();
-    bool all_done = true;
-    for (int a = 1; a < mesh.rows(); ++a)
-      for (int b = 1; b < mesh.cols(); ++b) {
-        if (sim.state().pinned(mesh, a, b)) continue;
-        const int point = mesh.node_point(a, b);
-        if (sim.state().x(2, point) <= goal_x(2, point)) apply(Action::pin(a, b));
-        else all_done = false;
-      }
-    for (int r = 0; r < mesh.rows(); ++r)
-      for (int c = 0; c < mesh.cols(); ++c) {
-        if (sim.state().jammed(mesh, r, c)) continue;
-        if (cell_curvature(mesh, sim.state().x, r, c) <= goal_curvature(r, c)) apply(Action::jam(r, c));
-        else all_done = false;
-      }
+    const bool nodes_done = pin_reached_nodes(sim, goal_x, Reach::kFromAbove, result, callbacks);
+    const bool cells_done = jam_reached_cells(sim, goal_curvature, Reach::kFromAbove, result, callbacks);
+    const bool all_done = nodes_done && cells_done;
     progress(0.1 + 0.8 * (top - pressure) / std::max(top - p_floor, 1e-9), pressure, "lowering");
     if (all_done) break;
     if (result.steps.size() > steps_before + 1) step = options_.decrement_pa;  // pinned or jammed: full steps again
@@ -130,14 +126,14 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
   for (const std::vector<double>* direction : {&below, &above}) {
     const double from = best_pressure;
     for (double p : *direction) {
-      apply(Action::set_pressure(p));
+      if (!apply(p)) break;
       const double r = score();
       if (!(r > best_r)) break;
       best_r = r, best_pressure = p;
     }
     if (best_pressure != from) break;
   }
-  if (sim.state().pressure_pa != best_pressure) apply(Action::set_pressure(best_pressure));
+  if (sim.state().pressure_pa != best_pressure) apply(best_pressure);
   progress(1.0, best_pressure, "done");
   result.final_state = sim.state();
   return result;

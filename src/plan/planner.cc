@@ -1,8 +1,12 @@
 #include "plan/planner.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <sstream>
+
+#include "metrics/correlation.h"
+#include "sim/surface_measures.h"
 
 namespace hj {
 
@@ -51,6 +55,10 @@ void validate_plan_request(const PlanRequest& request, const Mesh& mesh) {
 SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbacks& callbacks) {
   SimulatorOptions options = request.simulator;
   if (callbacks.cancelled) options.interrupted = callbacks.cancelled;
+  options.refuse_folded = true;
+  // No explicit Euler fallback: a settle that the static solver and the
+  // implicit flow cannot finish is a dead end (refused), found in seconds.
+  options.fallback_max_steps = 0;
   return options;
 }
 
@@ -71,6 +79,68 @@ void apply_planned(Simulator& sim, const Action& action, PlanResult& result, con
   }
   result.steps.push_back(action);
   if (callbacks.snapshot) callbacks.snapshot(sim.state());
+}
+
+bool try_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks) {
+  try {
+    apply_planned(sim, action, result, callbacks);
+    return true;
+  } catch (const NoEquilibrium& e) {
+    result.refused.push_back({action, e.what(), int(result.steps.size())});
+    return false;
+  }
+}
+
+bool pin_reached_nodes(Simulator& sim, const Eigen::Matrix3Xd& goal_x, Reach reach, PlanResult& result,
+                       const PlanCallbacks& callbacks) {
+  const Mesh& mesh = sim.mesh();
+  bool all_pinned = true;
+  for (int a = 1; a < mesh.rows(); ++a)
+    for (int b = 1; b < mesh.cols(); ++b) {
+      if (sim.state().pinned(mesh, a, b)) continue;
+      const int point = mesh.node_point(a, b);
+      const double z = sim.state().x(2, point), goal = goal_x(2, point);
+      const bool reached = reach == Reach::kFromBelow ? z >= goal : z <= goal;
+      if (!(reached && try_planned(sim, Action::pin(a, b), result, callbacks))) all_pinned = false;
+    }
+  return all_pinned;
+}
+
+bool jam_reached_cells(Simulator& sim, const Eigen::MatrixXd& goal_curvature, Reach reach, PlanResult& result,
+                       const PlanCallbacks& callbacks) {
+  const Mesh& mesh = sim.mesh();
+  bool all_jammed = true;
+  for (int r = 0; r < mesh.rows(); ++r)
+    for (int c = 0; c < mesh.cols(); ++c) {
+      if (sim.state().jammed(mesh, r, c)) continue;
+      const double k = cell_curvature(mesh, sim.state().x, r, c);
+      const bool reached = reach == Reach::kFromBelow ? k >= goal_curvature(r, c) : k <= goal_curvature(r, c);
+      if (!(reached && try_planned(sim, Action::jam(r, c), result, callbacks))) all_jammed = false;
+    }
+  return all_jammed;
+}
+
+bool every_cell_jammed(const Mesh& mesh, const DeviceState& state) {
+  for (int r = 0; r < mesh.rows(); ++r)
+    for (int c = 0; c < mesh.cols(); ++c)
+      if (!state.jammed(mesh, r, c)) return false;
+  return true;
+}
+
+Eigen::Matrix3Xd goal_positions(const Mesh& mesh, const Eigen::MatrixXd& goal_mm, double scale) {
+  Eigen::Matrix3Xd goal_x = mesh.rest_positions();
+  for (int i = 0; i < mesh.point_rows(); ++i)
+    for (int j = 0; j < mesh.point_cols(); ++j) goal_x(2, mesh.index(i, j)) = scale * goal_mm(i, j) / 1000.0;
+  return goal_x;
+}
+
+double plan_score(const PlanRequest& request, const Mesh& mesh, const DeviceState& state) {
+  const Eigen::MatrixXd heights_mm = point_heights(mesh, state.x) * 1000.0;
+  // Mesh row i runs along +y; the image's row 0 is its top.
+  const Correlation c = request.goal_image.size() > 0
+                            ? correlate_with_goal(request.goal_image, heights_mm.colwise().reverse())
+                            : correlate(request.goal_mm, heights_mm);
+  return c.value.value_or(-INFINITY);
 }
 
 double plan_max_pressure(double option_pa, const SurfaceParameters& params) {

@@ -23,6 +23,9 @@ struct PlanRequest {
   // ((R p + 1) x (C p + 1)) goal height of each mesh point (i, j), mm.
   Eigen::MatrixXd goal_mm;
   SimulatorOptions simulator;
+  // The goal image the plan is scored against (Eq. 12; row 0 at the top),
+  // if the caller has it; empty: plans are compared at the mesh points.
+  Eigen::MatrixXd goal_image;
 };
 
 struct PlanCallbacks {
@@ -34,9 +37,22 @@ struct PlanCallbacks {
   std::function<bool()> cancelled;
 };
 
+// An action a planner tried and did not take: its settle found no static
+// equilibrium, or one with the mesh folded (mesh_folds.h), a dead end the
+// model cannot follow reliably.
+struct RefusedAction {
+  Action action;
+  std::string reason;
+  int after_step = 0;  // how many of the plan's steps came before it
+};
+
 struct PlanResult {
   std::vector<Action> steps;  // in the order to apply them, from rest
   DeviceState final_state;    // the predicted surface
+  std::vector<RefusedAction> refused;
+  // How the planner came to it, for people (e.g. the strategy a portfolio
+  // chose and the scores of the others); may be empty.
+  std::string note;
 };
 
 class PlanCancelled : public std::runtime_error {
@@ -60,7 +76,8 @@ void register_planner(const std::string& name, std::function<std::unique_ptr<Pla
 
 // The request's simulator options with callbacks.cancelled polled inside
 // every settle too, so a cancel stops a long settle, not only the plan
-// between actions (catch SettleInterrupted, throw PlanCancelled).
+// between actions (catch SettleInterrupted, throw PlanCancelled); folded
+// equilibria refused (SimulatorOptions::refuse_folded); no explicit fallback.
 SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbacks& callbacks);
 
 // The request's simulator settled at rest, its settles cancellable
@@ -71,6 +88,35 @@ Simulator start_simulator(const PlanRequest& request, const PlanCallbacks& callb
 // settle thrown as PlanCancelled, the action recorded in result.steps and
 // the state sent to callbacks.snapshot.
 void apply_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks);
+
+// As apply_planned, but a settle with no (unfolded) equilibrium is a dead
+// end, not the end of the plan: the simulator keeps the state it had, the
+// action goes to result.refused with the reason, and false is returned.
+bool try_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks);
+
+// The side from which a rising (Algorithm 2) or falling (from-above)
+// surface reaches its goal: a node's height or a cell's curvature at or
+// above the goal's, or at or below it.
+enum class Reach { kFromBelow, kFromAbove };
+
+// Pins, in row-major order, every free node that has reached its goal
+// height (goal_x: 3 x N, m); true if every node is then pinned.
+bool pin_reached_nodes(Simulator& sim, const Eigen::Matrix3Xd& goal_x, Reach reach, PlanResult& result,
+                       const PlanCallbacks& callbacks);
+// Jams, in row-major order, every free cell whose curvature (Eq. 11) has
+// reached its goal cell's ((R x C)); true if every cell is then jammed.
+bool jam_reached_cells(Simulator& sim, const Eigen::MatrixXd& goal_curvature, Reach reach, PlanResult& result,
+                       const PlanCallbacks& callbacks);
+// True if every cell of the state is jammed.
+bool every_cell_jammed(const Mesh& mesh, const DeviceState& state);
+
+// The goal as a surface on the mesh: rest positions with z = scale * goal_mm / 1000 (3 x N, m).
+Eigen::Matrix3Xd goal_positions(const Mesh& mesh, const Eigen::MatrixXd& goal_mm, double scale = 1.0);
+
+// How well a state matches the request's goal: Eq. 12 against goal_image
+// when given, else the correlation with goal_mm at the mesh points; -inf
+// where undefined. Planners that choose among candidates maximise it.
+double plan_score(const PlanRequest& request, const Mesh& mesh, const DeviceState& state);
 
 // A planner's pressure ceiling: its option (0: none) capped by the device's.
 double plan_max_pressure(double option_pa, const SurfaceParameters& params);

@@ -18,12 +18,26 @@
 
 namespace hj {
 
-std::vector<ArraySize> paper_array_sizes() { return {{2, 2}, {3, 4}, {4, 6}, {6, 8}, {9, 12}}; }
+std::vector<ArraySize> paper_array_sizes() {
+  return {{1, 2}, {2, 3}, {3, 4}, {3, 5}, {4, 5}, {4, 6}, {5, 6},  {5, 7},
+          {5, 8}, {6, 7}, {6, 8}, {6, 9}, {7, 9}, {7, 10}, {8, 11}, {9, 12}};
+}
 
-std::vector<double> table2_alphas() { return {0.0, 1.0 / 6.0, 1.0 / 3.0, 0.5, 1.0}; }
+std::vector<ArraySize> quick_array_sizes() { return {{2, 2}, {3, 4}, {4, 6}, {6, 8}, {9, 12}}; }
+
+std::vector<double> table2_alphas() { return {0.0, 1.0 / 8.0, 1.0 / 4.0, 0.5, 1.0}; }
+
+std::optional<double> paper_table2_r2(double alpha) {
+  const std::vector<double> r2 = {0.7555, 0.7583, 0.7545, 0.7412, 0.7293};
+  const std::vector<double> alphas = table2_alphas();
+  for (std::size_t k = 0; k < alphas.size(); ++k)
+    if (std::abs(alpha - alphas[k]) < 1e-12) return r2[k];
+  return std::nullopt;
+}
 
 std::vector<ArraySize> parse_array_sizes(const std::string& text) {
   if (text == "paper") return paper_array_sizes();
+  if (text == "quick") return quick_array_sizes();
   std::vector<ArraySize> out;
   std::istringstream in(text);
   for (std::string item; std::getline(in, item, ',');) {
@@ -49,10 +63,9 @@ std::vector<ArraySize> parse_array_sizes(const std::string& text) {
 void SweepOptions::validate() const {
   if (sizes.empty()) throw std::invalid_argument("SweepOptions.sizes must not be empty");
   if (segments < 2) throw std::invalid_argument("SweepOptions.segments must be >= 2");
-  if (!(max_height_mm > 0.0) || !std::isfinite(max_height_mm))
-    throw std::invalid_argument("SweepOptions.max_height_mm must be a positive number of mm");
+  if (!(max_height_mm >= 0.0) || !std::isfinite(max_height_mm))
+    throw std::invalid_argument("SweepOptions.max_height_mm must be a positive number of mm (0: the array's default)");
   if (jobs < 0) throw std::invalid_argument("SweepOptions.jobs must be >= 0 (0: one per core)");
-  if (fallback_max_steps < 0) throw std::invalid_argument("SweepOptions.fallback_max_steps must be >= 0 (0: the default)");
   if (!(budget_s > 0.0)) throw std::invalid_argument("SweepOptions.budget_s must be a positive number of seconds");
   for (double a : alphas)
     if (!(a >= 0.0 && a <= 1.0)) throw std::invalid_argument("SweepOptions.alphas must lie in [0, 1]");
@@ -72,14 +85,15 @@ SweepRow run_one(const SweepGoal& goal, ArraySize size, const SweepOptions& opti
   try {
     const ArrayGeometry geometry{size.rows, size.cols, 0.038, options.segments};
     const Mesh mesh(geometry);
+    row.relief_mm = relief_or_default_mm(options.max_height_mm, geometry);
     PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),
-                        resample_to_mesh(goal.map, mesh, options.max_height_mm), {}};
-    if (options.fallback_max_steps > 0) request.simulator.fallback_max_steps = options.fallback_max_steps;
+                        resample_to_mesh(goal.map, mesh, row.relief_mm), {}, goal.map.z};
     for (double a : options.alphas) row.laplace_mean.push_back(laplace_mean(request.goal_mm, a));
     PlanCallbacks callbacks;
     callbacks.cancelled = [&] { return elapsed() > options.budget_s; };
     const PlanResult result = make_planner(options.planner)->plan(request, callbacks);
     row.steps = int(result.steps.size());
+    row.refused = int(result.refused.size());
     // Mesh rows run along +y; the goal image's row 0 is its top.
     const Eigen::MatrixXd predicted_image = (point_heights(mesh, result.final_state.x) * 1000.0).colwise().reverse();
     const Correlation corr = correlate_with_goal(goal.map.z, predicted_image);

@@ -18,13 +18,15 @@ struct ArraySize {
   int rows = 0, cols = 0;
 };
 
-// The array sizes of the paper's Table 1 as we use them: 2x2, 3x4, 4x6, 6x8,
-// 9x12. (The paper's own table was not available to us; these span its
-// prototype, 3x4, to 9x12.)
+// The 16 array sizes of the paper's Table 1, 1x2 to 9x12 (2 to 108 cells).
 std::vector<ArraySize> paper_array_sizes();
-// The alpha_L values of the Table 2 analogue: 0, 1/6, 1/3 (Eq. 14), 1/2, 1.
+// Five sizes from 2x2 to 9x12 (2x2, 3x4, 4x6, 6x8, 9x12), for a quick look.
+std::vector<ArraySize> quick_array_sizes();
+// The alpha_L values of the paper's Table 2: 0, 1/8, 1/4, 1/2, 1.
 std::vector<double> table2_alphas();
-// "paper" or "RxC,RxC,..." (1..100 each). std::invalid_argument naming the text.
+// The paper's Table 2 r^2 at alpha (0.7555 .. 0.7293), or empty for another alpha.
+std::optional<double> paper_table2_r2(double alpha);
+// "paper", "quick" or "RxC,RxC,..." (1..100 each). std::invalid_argument naming the text.
 std::vector<ArraySize> parse_array_sizes(const std::string& text);
 
 struct SweepGoal {
@@ -36,15 +38,10 @@ struct SweepOptions {
   std::vector<ArraySize> sizes = paper_array_sizes();
   std::string planner = "algorithm2";
   int segments = 4;
-  double max_height_mm = 30.0;
+  double max_height_mm = 0.0;  // goal relief, mm; 0: each array's default_relief_mm
   int jobs = 0;            // threads; 0 = std::thread::hardware_concurrency()
   double budget_s = 120.0;  // per plan; checked between actions (a settle in progress is not interrupted)
   std::vector<double> alphas = table2_alphas();
-  // Steps the static solver's explicit fallback may take in one settle
-  // (SimulatorOptions::fallback_max_steps); a settle cannot be interrupted,
-  // so this bounds how far a hard case overruns budget_s. 0: the simulator's
-  // default (2,000,000). A settle that hits it fails the plan ("failed").
-  long fallback_max_steps = 200'000;
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -55,6 +52,8 @@ struct SweepRow {
   std::optional<double> correlation;  // Eq. 12; empty when undefined or the plan did not finish
   std::vector<double> laplace_mean;   // one per SweepOptions::alphas, of the goal as resampled to the mesh
   int steps = 0;
+  int refused = 0;         // actions the planner refused as dead ends (PlanResult::refused)
+  double relief_mm = 0.0;  // the goal's relief on this array
   double seconds = 0.0;
   std::string status;  // "ok", "undefined" (correlation undefined), "over-budget", "failed"
   std::string detail;  // the error or the reason the correlation is undefined

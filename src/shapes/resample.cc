@@ -71,6 +71,18 @@ void fill_from_nearest(const Eigen::MatrixXd& z, const Eigen::MatrixXd& weight, 
 
 }  // namespace
 
+double default_relief_mm(const ArrayGeometry& geometry) {
+  return kReliefPerShortSide * std::min(geometry.rows, geometry.cols) * geometry.cell_size_m * 1000.0;
+}
+
+double relief_or_default_mm(double requested_mm, const ArrayGeometry& geometry) {
+  return requested_mm > 0.0 ? requested_mm : default_relief_mm(geometry);
+}
+
+Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh) {
+  return resample_to_mesh(goal, mesh, default_relief_mm(mesh.geometry()));
+}
+
 Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh, double max_height_mm) {
   check_goal(goal, max_height_mm);
   // (rows x cols), row 0 = top; NaN that means "floor" becomes that height.

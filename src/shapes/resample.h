@@ -10,10 +10,14 @@
 
 namespace hj {
 
-// Default relief of a goal, in mm from its lowest to its highest point: about
-// 0.8 of the paper's 38 mm cell side. A chosen default, not a measured limit
-// of the device; a planner that cannot reach it should ask for less.
-constexpr double kDefaultMaxHeightMm = 30.0;
+// Default relief of a goal, in mm from its lowest to its highest point. As in
+// the paper, it scales with the array's length dimensions: kReliefPerShortSide
+// times the array's shorter side (38 mm cells: 10 mm a cell, so 30 mm on the
+// 3 x 4 prototype, 90 mm on 9 x 12). A chosen default, not a device limit.
+constexpr double kReliefPerShortSide = 30.0 / 114.0;
+double default_relief_mm(const ArrayGeometry& geometry);
+// requested_mm if positive, else the default relief of the array.
+double relief_or_default_mm(double requested_mm, const ArrayGeometry& geometry);
 
 // Returns (R*p+1 x C*p+1) heights in mm, element (i, j) for mesh point (i, j)
 // (i along +y, j along +x). The image covers the array's rectangle exactly
@@ -27,7 +31,8 @@ constexpr double kDefaultMaxHeightMm = 30.0;
 // [0, max_height_mm]; a flat goal gives all zeros.
 // @throws std::invalid_argument on an empty goal, one with no valid pixel or
 //         an infinite value, or max_height_mm not positive and finite.
-Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh,
-                                 double max_height_mm = kDefaultMaxHeightMm);
+Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh, double max_height_mm);
+// The same at the array's default relief.
+Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh);
 
 }  // namespace hj

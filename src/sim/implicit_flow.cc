@@ -107,6 +107,7 @@ SettleReport settle_implicit_flow(const ForceModel& model, DeviceState& state, c
       continue;
     }
     state.x += k.scatter(moved);
+    if (options.abandon && options.abandon(state.x)) break;
     f.swap(f_y);
     residual = k.gather(f);
     mu = std::max(mu * (newton <= 1 ? kShiftDownEasy : newton <= 3 ? kShiftDown : 1.0), kMinShift * spring_k);

@@ -12,6 +12,14 @@ class SettleInterrupted : public std::runtime_error {
   SettleInterrupted() : std::runtime_error("the settle was interrupted") {}
 };
 
+// An action after which the simulator found no static equilibrium (or, with
+// SimulatorOptions::refuse_folded, only a folded one); the state is left as
+// it was before the action.
+class NoEquilibrium : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 struct SettleReport {
   bool converged = false;
   int iterations = 0;        // Newton steps or time steps

@@ -34,6 +34,8 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
   options_.static_options.validate();
   options_.explicit_options.validate();
   options_.flow_options.validate();
+  if (!(options_.refuse_fold_deg >= 90.0 && options_.refuse_fold_deg <= 180.0))
+    throw std::invalid_argument("simulator option refuse_fold_deg (degrees) must lie in [90, 180]");
   if (options_.fallback_max_steps < 0)
     throw std::invalid_argument("simulator option fallback_max_steps must be >= 0 (0: no explicit fallback)");
   if (options_.interrupted)
@@ -88,6 +90,7 @@ void Simulator::settle_once(bool fallbacks) {
   SettleReport tried;  // what the fast control and the flow spent first
   if (fallbacks && options_.flow_fallback && options_.flow_first && options_.static_options.fast_iterations > 0) {
     if (settle_fast_then_flow(before)) return;
+    if (dead_end_) return;
     tried = last_;
   }
   StaticSolverOptions static_options = options_.static_options;
@@ -106,6 +109,13 @@ bool Simulator::settle_fast_then_flow(const Eigen::Matrix3Xd& before) {
   SettleReport spent = last_;
   state_.x = before;
   if (flow_then_polish(1, spent)) return true;
+  if (options_.refuse_folded && folded_past_refusal(state_.x)) {
+    // The model's own dynamics lead into a fold: a dead end for a planner.
+    dead_end_ = true;
+    last_ = spent;
+    last_.converged = false;
+    return false;
+  }
   // Neither: the careful controls from the start, as without this.
   state_.x = before;
   last_ = SettleReport{};
@@ -125,9 +135,20 @@ bool Simulator::polish(const SettleReport& fallback, SettleReport& spent) {
   return last_.converged;
 }
 
+bool Simulator::folded_past_refusal(const Eigen::Matrix3Xd& x) const {
+  return find_mesh_folds(mesh(), x).sharpest_deg > options_.refuse_fold_deg;
+}
+
+ImplicitFlowOptions Simulator::flow_options() const {
+  ImplicitFlowOptions options = options_.flow_options;
+  if (options_.refuse_folded)
+    options.abandon = [this](const Eigen::Matrix3Xd& x) { return folded_past_refusal(x); };
+  return options;
+}
+
 bool Simulator::flow_then_polish(int rounds, SettleReport& spent) {
   for (int round = 0; round < rounds; ++round) {
-    const SettleReport flow = settle_implicit_flow(model_, state_, options_.flow_options);
+    const SettleReport flow = settle_implicit_flow(model_, state_, flow_options());
     if (!flow.converged) {
       spent.iterations += flow.iterations;
       spent.seconds += flow.seconds;
@@ -167,6 +188,7 @@ const SettleReport& Simulator::apply(const Action& action, const Eigen::Matrix3X
 
 const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Matrix3Xd* start) {
   action.validate(mesh(), params());
+  dead_end_ = false;
   const DeviceState before = state_;
   const Mesh& m = mesh();
   std::optional<Eigen::Matrix3Xd> predicted;
@@ -236,8 +258,14 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
     // Where the settle stopped: a folded mesh is the usual reason (mesh_folds.h).
     const std::string folds = find_mesh_folds(m, state_.x).describe();
     state_ = before;
-    throw std::runtime_error("no static equilibrium found after " + action.describe() + " (residual " +
-                             std::to_string(last_.residual_n) + " N" + (folds.empty() ? "" : "; " + folds) + ")");
+    throw NoEquilibrium("no static equilibrium found after " + action.describe() + " (residual " +
+                        std::to_string(last_.residual_n) + " N" + (folds.empty() ? "" : "; " + folds) + ")");
+  }
+  if (options_.refuse_folded) {
+    if (const MeshFolds folds = find_mesh_folds(m, state_.x); folds.sharpest_deg > options_.refuse_fold_deg) {
+      state_ = before;
+      throw NoEquilibrium("the equilibrium after " + action.describe() + " is folded: " + folds.describe());
+    }
   }
   return last_;
 }

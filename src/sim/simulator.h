@@ -54,6 +54,13 @@ struct SimulatorOptions {
   // free DOFs, p >= 4) starts from the same settle on a mesh of half the
   // segments (coarse_start.h) rather than from the mirrored sag alone.
   bool coarse_start = true;
+  // With refuse_folded, a state whose sharpest fold (mesh_folds.h) turns
+  // back by more than refuse_fold_deg, where the Eq. 3 normals are nearly
+  // ill-defined, counts as no equilibrium (apply throws NoEquilibrium and
+  // leaves the state as it was), and a flow that reaches one stops there.
+  // Planners set it: such a settle is a dead end.
+  bool refuse_folded = false;
+  double refuse_fold_deg = 150.0;
   // Effects beyond the baseline, by registry name, and their parameter
   // values (effect name -> parameter name -> value; missing = default).
   std::vector<std::string> extra_effects;
@@ -76,9 +83,9 @@ class Simulator {
   const SettleReport& last_settle() const { return last_; }
 
   // Validates (std::invalid_argument naming what is wrong), applies and
-  // settles. Repeating an action changes nothing. Throws std::runtime_error
-  // if no equilibrium is found, SettleInterrupted if interrupted (the state
-  // is left as it was in both cases).
+  // settles. Repeating an action changes nothing. Throws NoEquilibrium if no
+  // equilibrium is found, SettleInterrupted if interrupted (the state is left
+  // as it was in both cases).
   const SettleReport& apply(const Action& action);
   // As apply(action), but the settle starts with the free points at `start`
   // (3 x N), e.g. the settled state of the same step under nearby
@@ -108,6 +115,9 @@ class Simulator {
   // `rounds` rounds: a polish that pushes off a saddle and does not settle
   // again leaves the state beside it, and the flow goes on from there.
   bool flow_then_polish(int rounds, SettleReport& spent);
+  // options_.flow_options, with SimulatorOptions::refuse_folded: stopping at the first fold.
+  ImplicitFlowOptions flow_options() const;
+  bool folded_past_refusal(const Eigen::Matrix3Xd& x) const;
   const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
   SimulatorOptions options_;
@@ -122,6 +132,9 @@ class Simulator {
   bool keeps_equilibrium_ = false;
   // Set by apply_from while a settle starts from the coarse mesh's dome.
   bool close_start_ = false;
+  // With refuse_folded: the flow from the state before the action folded
+  // the mesh, so the settle ends there without the slower controls.
+  bool dead_end_ = false;
 };
 
 // Parses "static" / "explicit"; std::invalid_argument otherwise.

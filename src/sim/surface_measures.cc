@@ -29,11 +29,13 @@ Eigen::MatrixXd node_heights(const Mesh& mesh, const Eigen::Matrix3Xd& x) {
   return out;
 }
 
-Eigen::MatrixXd point_heights(const Mesh& mesh, const Eigen::Matrix3Xd& x) {
+Eigen::MatrixXd point_coordinates(const Mesh& mesh, const Eigen::Matrix3Xd& x, int axis) {
   Eigen::MatrixXd out(mesh.point_rows(), mesh.point_cols());
   for (int i = 0; i < mesh.point_rows(); ++i)
-    for (int j = 0; j < mesh.point_cols(); ++j) out(i, j) = x(2, mesh.index(i, j));
+    for (int j = 0; j < mesh.point_cols(); ++j) out(i, j) = x(axis, mesh.index(i, j));
   return out;
 }
+
+Eigen::MatrixXd point_heights(const Mesh& mesh, const Eigen::Matrix3Xd& x) { return point_coordinates(mesh, x, 2); }
 
 }  // namespace hj

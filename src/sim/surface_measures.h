@@ -18,5 +18,7 @@ Eigen::MatrixXd cell_curvatures(const Mesh& mesh, const Eigen::Matrix3Xd& x);
 Eigen::MatrixXd node_heights(const Mesh& mesh, const Eigen::Matrix3Xd& x);
 // ((R p + 1) x (C p + 1)) heights z of every point, m.
 Eigen::MatrixXd point_heights(const Mesh& mesh, const Eigen::Matrix3Xd& x);
+// The same for any coordinate (axis 0: x, 1: y, 2: z), m.
+Eigen::MatrixXd point_coordinates(const Mesh& mesh, const Eigen::Matrix3Xd& x, int axis);
 
 }  // namespace hj

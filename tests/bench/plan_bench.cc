@@ -26,7 +26,7 @@ void plan_once(benchmark::State& state, const hj::Planner& planner, const hj::Pl
 void BM_PlanVolcanoDem(benchmark::State& state) {
   const hj::ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038, 4};
   const hj::HeightMap goal = hj::import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
-  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}};
+  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}, {}};
   const auto planner = hj::make_planner("algorithm2");
   for (auto _ : state) plan_once(state, *planner, request);
 }
@@ -38,7 +38,7 @@ BENCHMARK(BM_PlanVolcanoDem)->Name("Slow/BM_PlanVolcanoDem")->Args({6, 8})->Args
 void BM_PlanVolcanoDemFromAbove(benchmark::State& state) {
   const hj::ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038, 4};
   const hj::HeightMap goal = hj::import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
-  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}};
+  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}, {}};
   const auto planner = hj::make_planner("from-above");
   for (auto _ : state) plan_once(state, *planner, request);
 }
@@ -80,7 +80,7 @@ BENCHMARK_CAPTURE(BM_SweepVolcano, paper, "paper")
 void BM_PlanLuxembourgGeoTiff(benchmark::State& state) {
   const hj::ArrayGeometry g{3, 4, 0.038, 4};
   const hj::HeightMap goal = hj::import_goal(HJ_SHARED_DIR "/data/dem/luxembourg_elev.tif");
-  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}};
+  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, hj::Mesh(g), 30.0), {}, {}};
   const auto planner = hj::make_planner("algorithm2");
   for (auto _ : state) benchmark::DoNotOptimize(planner->plan(request).steps.size());
 }

@@ -67,6 +67,30 @@ void BM_SettleCentreJamThenStep(benchmark::State& state) {
       Action::set_pressure(1900.0));
 }
 
+// A planner's session end to end, as one timed run from a fresh simulator:
+// rest, 2 kPa, jam an off-centre cell, pin an off-centre node, 2.5 kPa.
+void BM_SettleJamPinSession(benchmark::State& state) {
+  const ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038,
+                        static_cast<int>(state.range(2))};
+  SimulatorOptions options;
+  options.solver = state.range(3) == 0 ? SolverKind::kStatic : SolverKind::kExplicit;
+  const Action session[] = {Action::set_pressure(2000.0), Action::jam(1, 1), Action::pin(2, 2),
+                            Action::set_pressure(2500.0)};
+  long iterations = 0;
+  for (auto _ : state) {
+    try {
+      hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
+      iterations += sim.last_settle().iterations;
+      for (const Action& a : session) iterations += sim.apply(a).iterations;
+    } catch (const std::exception& e) {
+      state.SkipWithError(e.what());
+      break;
+    }
+  }
+  state.counters["solver_iterations"] =
+      benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+}
+
 BENCHMARK(BM_SettleRestTo2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SettleCentreJamThenStep)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
@@ -74,6 +98,8 @@ BENCHMARK(BM_SettleCentreJamThenStep)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->A
 // explicit Euler there takes over an hour), and the 9 x 12
 // jammed step (2 -> 1 kPa; a corner cell jammed keeps no mirror, so it
 // settles on every DOF: 113 steps, 1.3-1.6 s on 2026-12-01).
+BENCHMARK(BM_SettleJamPinSession)->Args({3, 4, 4, 0})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_SettleJamPinSession)->Name("Slow/BM_SettleJamPinSession")->Args({3, 4, 4, 1})->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleRestTo2kPa)->Name("Slow/BM_SettleRestTo2kPa")->Args({9, 12, 4, 1})->Args({9, 12, 10, 0})->Args({9, 12, 10, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Name("Slow/BM_SettleOneActionAfter2kPa")->Args({9, 12, 4, 0})->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleCentreJamThenStep)->Name("Slow/BM_SettleCentreJamThenStep")->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);

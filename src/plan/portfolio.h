@@ -1,0 +1,40 @@
+// A planner that runs several strategies on the same goal in parallel and
+// keeps the plan whose surface scores best (plan_score: Eq. 12 against the
+// goal image when the request has it). The paper's Algorithm 2 is one of
+// them, so the result is never worse than Algorithm 2's by that score. The
+// others: from-above (from_above.h), and Algorithm 2 variants
+// (algorithm2_refined.h) that jam no cell below the levelling pressure and
+// aim at 1, 2 and 3 times the goal, with pins landing on their targets and
+// a scan of end pressures. See portfolio.cc.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "plan/planner.h"
+
+namespace hj {
+
+struct PortfolioOptions {
+  // Threads that run strategies at once; 0: one per core.
+  int threads = 0;
+  // Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+class Portfolio final : public Planner {
+ public:
+  explicit Portfolio(PortfolioOptions options = {});
+  std::string name() const override { return "portfolio"; }
+  // Streams the snapshots of the Algorithm 2 strategy as it runs and, at the
+  // end, the chosen plan's final state; progress counts finished strategies.
+  PlanResult plan(const PlanRequest& request, const PlanCallbacks& callbacks = {}) const override;
+
+  // The strategies, by label, in the order they are started.
+  static std::vector<std::pair<std::string, std::unique_ptr<Planner>>> strategies();
+
+ private:
+  PortfolioOptions options_;
+};
+
+}  // namespace hj

@@ -1,0 +1,84 @@
+// Plans that finish at every size (refused dead ends instead of failures),
+// replay from rest to their predicted surface, and the portfolio planner,
+// which is never worse than Algorithm 2 by the score it is judged on.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "plan/planner.h"
+#include "plan/portfolio.h"
+#include "shapes/goal_importer.h"
+#include "shapes/resample.h"
+#include "sim/mesh_folds.h"
+#include "sim/surface_measures.h"
+
+namespace hj {
+namespace {
+
+Eigen::MatrixXd heights_mm(const Mesh& mesh, const DeviceState& state) { return point_heights(mesh, state.x) * 1000.0; }
+
+// The plan's steps replayed from rest, as `hapticjam simulate` does: the
+// largest distance of a point from the plan's predicted surface, m.
+double replay_gap_m(const PlanRequest& request, const PlanResult& plan) {
+  Simulator replay(request.geometry, request.params);
+  for (const Action& a : plan.steps) replay.apply(a);
+  return (replay.state().x - plan.final_state.x).cwiseAbs().maxCoeff();
+}
+
+// A surface the device itself made (above levelling, one jam, one pin), so
+// a good planner can match it.
+Eigen::MatrixXd device_made_goal(const ArrayGeometry& g) {
+  Simulator device(g, SurfaceParameters::paper_defaults(g));
+  for (const Action& a : {Action::set_pressure(1200), Action::jam(g.rows / 2, g.cols / 3), Action::pin(g.rows / 2, g.cols / 2),
+                          Action::set_pressure(800)})
+    device.apply(a);
+  return heights_mm(device.mesh(), device.state());
+}
+
+void expect_matches_device_made_goal(const ArrayGeometry& g) {
+  const PlanRequest request{g, SurfaceParameters::paper_defaults(g), device_made_goal(g), {}, {}};
+  const PlanResult plan = Portfolio().plan(request);
+  const Mesh mesh(g);
+  EXPECT_GT(plan_score(request, mesh, plan.final_state), 0.95) << plan.note;
+  EXPECT_LT(replay_gap_m(request, plan), 1e-5);
+}
+
+TEST(Portfolio, MatchesADeviceMadeGoalAt6x8) { expect_matches_device_made_goal({6, 8, 0.038, 4}); }
+TEST(Portfolio, MatchesADeviceMadeGoalAt9x12) { expect_matches_device_made_goal({9, 12, 0.038, 4}); }
+
+TEST(Portfolio, IsNeverBelowAlgorithm2AndSaysWhatItChose) {
+  const ArrayGeometry g{3, 4, 0.038, 4};
+  const Mesh mesh(g);
+  const HeightMap volcano = import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
+  const PlanRequest request{g, SurfaceParameters::paper_defaults(g), resample_to_mesh(volcano, mesh), {}, volcano.z};
+  const PlanResult paper = make_planner("algorithm2")->plan(request);
+  int snapshots = 0;
+  PlanCallbacks callbacks;
+  callbacks.snapshot = [&](const DeviceState&) { ++snapshots; };
+  const PlanResult best = make_planner("portfolio")->plan(request, callbacks);
+  EXPECT_GE(plan_score(request, mesh, best.final_state), plan_score(request, mesh, paper.final_state));
+  EXPECT_NE(best.note.find("chose "), std::string::npos) << best.note;
+  EXPECT_NE(best.note.find("algorithm2"), std::string::npos) << best.note;
+  EXPECT_GT(snapshots, 5);  // Algorithm 2's, streamed as it runs, then the chosen one
+  EXPECT_LT(replay_gap_m(request, best), 1e-5);
+}
+
+TEST(RefusedActions, ADeadEndIsRecordedAndThePlanFinishes) {
+  // The volcano at 4 x 5 from rest: Algorithm 2 jams cells in the sag, and
+  // raising the pressure past them folds the net; those steps are refused.
+  const ArrayGeometry g{4, 5, 0.038, 4};
+  const Mesh mesh(g);
+  const HeightMap volcano = import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
+  const PlanRequest request{g, SurfaceParameters::paper_defaults(g), resample_to_mesh(volcano, mesh), {}, volcano.z};
+  const PlanResult plan = make_planner("algorithm2")->plan(request);
+  for (const RefusedAction& r : plan.refused) {
+    EXPECT_EQ(r.action.op, Action::Op::kSetPressure) << r.action.describe();
+    EXPECT_FALSE(r.reason.empty());
+    EXPECT_LE(r.after_step, int(plan.steps.size()));
+  }
+  EXPECT_FALSE(find_mesh_folds(mesh, plan.final_state.x).sharpest_deg > SimulatorOptions{}.refuse_fold_deg);
+  EXPECT_LT(replay_gap_m(request, plan), 1e-5);
+}
+
+}  // namespace
+}  // namespace hj
