@@ -1,0 +1,87 @@
+"""The gateway without a browser: its HTTP answers to good and bad requests,
+against a real server (clients/web/tests/rig.py). Run by ctest (web_gateway)."""
+
+import http.client
+import json
+import unittest
+
+from rig import TOKENS, Stack
+
+
+class GatewayTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.stack = Stack()
+        cls.host, cls.port = cls.stack.url[len("http://"):-1].split(":")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.stack.close()
+
+    def call(self, method, path, body=None, token=None, api_header=True):
+        connection = http.client.HTTPConnection(self.host, int(self.port), timeout=120)
+        headers = {"Content-Type": "application/json"}
+        if api_header:
+            headers["X-Hapticjam-Web"] = "1"
+        if token:
+            headers["Authorization"] = "Bearer " + token
+        connection.request(method, path, body=None if body is None else json.dumps(body), headers=headers)
+        response = connection.getresponse()
+        data = response.read()
+        connection.close()
+        return response.status, data
+
+    def test_roles_come_from_the_server(self):
+        for role, token in TOKENS.items():
+            status, data = self.call("GET", "/api/role", token=token)
+            self.assertEqual(status, 200)
+            # The API cannot tell an admin from an operator without acting.
+            self.assertEqual(json.loads(data)["role"], "preview" if role == "preview" else "operator")
+        self.assertEqual(json.loads(self.call("GET", "/api/role")[1])["role"], "none")
+
+    def test_a_refusal_is_the_servers_status_in_words(self):
+        status, data = self.call("POST", "/api/device/submit", {"steps": [{"op": "capture"}]}, token=TOKENS["preview"])
+        self.assertEqual(status, 403)
+        error = json.loads(data)["error"]
+        self.assertEqual((error["call"], error["code"]), ("SubmitJob", "PERMISSION_DENIED"))
+        self.assertIn("needs operator", error["message"])
+        status, data = self.call("GET", "/api/info", token="not-a-token")
+        self.assertEqual((status, json.loads(data)["error"]["code"]), (401, "UNAUTHENTICATED"))
+
+    def test_bad_bodies_name_the_field(self):
+        status, data = self.call("POST", "/api/preview", {"rows": 3, "cols": "four", "goal": {"map": "volcano"}},
+                                 token=TOKENS["preview"])
+        self.assertEqual(status, 400)
+        self.assertIn("request.cols must be int", json.loads(data)["error"]["message"])
+        status, data = self.call("POST", "/api/preview", {"rows": 3, "cols": 4, "goal": {"map": "nowhere"}},
+                                 token=TOKENS["preview"])
+        self.assertEqual(status, 400)
+        self.assertIn("nowhere", json.loads(data)["error"]["message"])
+        status, data = self.call("POST", "/api/plan", {"rows": 3, "cols": 4, "goal": {"file": {"name": "a.csv",
+                                 "content_b64": "%%%"}}}, token=TOKENS["preview"])
+        self.assertEqual(status, 400)
+        self.assertIn("goal.file.content_b64 is not base64", json.loads(data)["error"]["message"])
+
+    def test_api_calls_without_the_pages_header_are_refused(self):
+        status, data = self.call("POST", "/api/device/stop", {}, token=TOKENS["admin"], api_header=False)
+        self.assertEqual(status, 403)
+        self.assertIn("X-Hapticjam-Web", json.loads(data)["error"]["message"])
+
+    def test_static_files_stay_inside_their_folders(self):
+        self.assertEqual(self.call("GET", "/")[0], 200)
+        self.assertEqual(self.call("GET", "/three/build/three.module.js")[0], 200)
+        self.assertEqual(self.call("GET", "/static/../hapticjam_web/calls.py")[0], 404)
+        self.assertEqual(self.call("GET", "/three/../../../etc/passwd")[0], 404)
+
+    def test_the_plan_stream_is_json_lines_ending_in_the_result(self):
+        status, data = self.call("POST", "/api/plan", {"rows": 3, "cols": 4, "segments": 2, "goal": {"map": "volcano"}},
+                                 token=TOKENS["preview"])
+        self.assertEqual(status, 200)
+        events = [json.loads(line) for line in data.decode().splitlines()]
+        self.assertIn("result", events[-1])
+        self.assertEqual(len(events[-1]["result"]["predicted"]["heights_mm"]), 7 * 9)
+        self.assertTrue(any("snapshot" in e for e in events))
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
