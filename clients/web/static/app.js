@@ -45,6 +45,7 @@ document.getElementById('token-form').addEventListener('submit', async (e) => {
   input.value = '';
   input.placeholder = session.token() ? 'token kept for this tab' : 'bearer token';
   await refreshRole();
+  await show();  // the page again, with what this token may see
 });
 
 window.addEventListener('hashchange', show);

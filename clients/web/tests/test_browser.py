@@ -94,6 +94,11 @@ class BrowserTest(unittest.TestCase):
             os.makedirs(SCREENSHOTS, exist_ok=True)
             self.browser.save_screenshot(os.path.join(SCREENSHOTS, name + ".png"))
 
+    def queue_rows(self):
+        """[(job id, the row's text)] of the queue table now (rows are redrawn at every change)."""
+        return [(int(i), t) for i, t in self.browser.execute_script(
+            "return [...document.querySelectorAll('#queue-body tr')].map((r) => [r.id.slice(4), r.innerText]);")]
+
     def signature(self, selector):
         return self.browser.execute_script(CANVAS_SIGNATURE, selector)
 
@@ -144,14 +149,13 @@ class BrowserTest(unittest.TestCase):
         self.wait(lambda: submit.is_enabled(), what="a current plan")
         self.by_id("job-name").send_keys("web: volcano")
         submit.click()
-        row = self.wait(lambda: [r for r in self.browser.find_elements(By.CSS_SELECTOR, "#queue-body tr")
-                                 if "web: volcano" in r.text], what="the job in the queue")[0]
-        job_id = int(row.get_attribute("id")[len("job-"):])
-        self.assertIn("alice", row.text)
+        job_id, text = self.wait(lambda: [r for r in self.queue_rows() if "web: volcano" in r[1]],
+                                 what="the job in the queue")[0]
+        self.assertIn("alice", text)
         with Client(self.stack.grpc_address, token=TOKENS["operator"]) as client:
             job = client.wait_for_job(job_id, timeout=120)
         self.assertEqual(job.name, "web: volcano")
-        self.wait(lambda: "done" in self.by_id(f"job-{job_id}").text, what="the job done on the page")
+        self.wait(lambda: any(i == job_id and "done" in t for i, t in self.queue_rows()), what="the job done on the page")
         self.screenshot("device")
 
     def test_4_zoom_into_two_regions_and_back(self):
@@ -161,11 +165,11 @@ class BrowserTest(unittest.TestCase):
         self.assertGreater(self.signature("figure.map")[0], 1000)
         width, height = canvas.size["width"], canvas.size["height"]
         for (x0, y0, x1, y1) in ((0.2, 0.2, 0.7, 0.7), (0.35, 0.35, 0.6, 0.6)):
+            count = len(self.browser.find_elements(By.CSS_SELECTOR, "#zoom-history button"))
             # Offsets are from the canvas's centre.
             (ActionChains(self.browser).move_to_element_with_offset(canvas, (x0 - 0.5) * width, (y0 - 0.5) * height)
              .click_and_hold().move_by_offset((x1 - x0) * width / 2, (y1 - y0) * height / 2)
              .move_by_offset((x1 - x0) * width / 2, (y1 - y0) * height / 2).release().perform())
-            count = len(self.browser.find_elements(By.CSS_SELECTOR, "#zoom-history button"))
             self.wait(lambda: len(self.browser.find_elements(By.CSS_SELECTOR, "#zoom-history button")) > count or
                       self.by_id("zoom-error").is_displayed(), what="the region's preview")
             self.assertFalse(self.by_id("zoom-error").is_displayed(), self.by_id("zoom-error").text)
