@@ -46,7 +46,22 @@ function showControls() {
   resume.addEventListener('click', () => act('/api/device/resume'));
   const stop = element('button', { id: 'emergency-stop', type: 'button', className: 'stop', textContent: 'EMERGENCY STOP' });
   stop.addEventListener('click', () => act('/api/device/stop', { reason: 'emergency stop from the web viewer' }));
-  box.append(name, submit, resume, stop);
+  const file = element('input', { id: 'plan-file-for-device', type: 'file', accept: '.json',
+                                  title: 'a plan.json (Plan page, hapticjam remote plan) as the current plan' });
+  file.addEventListener('change', () => loadPlanFile(file.files[0]));
+  box.append(name, submit, element('label', {}, 'or a plan.json ', file), resume, stop);
+}
+
+async function loadPlanFile(file) {
+  showError($('device-error'), null);
+  try {
+    const doc = JSON.parse(await file.text());
+    const steps = Array.isArray(doc) ? doc : doc.steps;
+    if (!Array.isArray(steps)) throw new Error('it has no "steps" list');
+    session.setPlan({ steps, planner: doc.planner || '', label: file.name });
+  } catch (error) {
+    showError($('device-error'), new Error(`${file.name}: not a plan.json (${error.message})`));
+  }
 }
 
 function progressCell(job) {

@@ -62,9 +62,12 @@ async function showGoalPicture(goal) {
   }
 }
 
+// The replayed snapshots share one colour scale (all of them and the goal);
+// the final surface and its goal share theirs.
 function picture(snapshot, withGoal) {
   const goalHeights = withGoal && result ? result.goal_heights_mm : null;
-  const all = snapshots.map((s) => s.heights_mm).concat(result ? [result.goal_heights_mm] : []);
+  const all = goalHeights ? [snapshot.heights_mm, goalHeights]
+    : snapshots.map((s) => s.heights_mm).concat(result ? [result.goal_heights_mm] : []);
   return { snapshot, goalHeights, rows: request.rows, cols: request.cols, range: rangeOf(all) };
 }
 

@@ -63,7 +63,11 @@ class ThreeView {
     const THREE = this.THREE;
     const grid = gridOf(picture.snapshot, picture.rows, picture.cols);
     const range = pictureRange(picture);
-    this.content.children.slice().forEach((c) => { this.content.remove(c); c.geometry && c.geometry.dispose(); });
+    this.content.children.slice().forEach((c) => {
+      this.content.remove(c);
+      c.geometry.dispose();
+      c.material.dispose();
+    });
     this.content.add(this.surfaceMesh(grid, picture.snapshot.heights_mm, range, 0, true));
     for (const [row, col] of picture.snapshot.jammed_cells) this.content.add(this.outline(grid, picture.snapshot, row, col));
     for (const [a, b] of picture.snapshot.pinned_nodes) this.content.add(this.pin(grid, picture.snapshot, a, b));
@@ -120,7 +124,7 @@ class ThreeView {
     const width = withGoal ? 2 * grid.widthMm + GAP_MM : grid.widthMm;
     const centre = new this.THREE.Vector3(width / 2, 0, -grid.depthMm / 2);
     const span = Math.max(width, grid.depthMm);
-    this.camera.position.set(centre.x, span * 0.75, centre.z + span * 1.05);
+    this.camera.position.set(centre.x, span * 0.5, centre.z + span * 0.75);
     this.controls.target.copy(centre);
     this.controls.update();
     this.resize();

@@ -1,11 +1,13 @@
 """The gateway without a browser: its HTTP answers to good and bad requests,
 against a real server (clients/web/tests/rig.py). Run by ctest (web_gateway)."""
 
+import base64
 import http.client
 import json
+import os
 import unittest
 
-from rig import TOKENS, Stack
+from rig import DEM, SHARED, TOKENS, Stack
 
 
 class GatewayTest(unittest.TestCase):
@@ -81,6 +83,30 @@ class GatewayTest(unittest.TestCase):
         self.assertIn("result", events[-1])
         self.assertEqual(len(events[-1]["result"]["predicted"]["heights_mm"]), 7 * 9)
         self.assertTrue(any("snapshot" in e for e in events))
+
+    def test_an_uploaded_goal_is_the_same_goal_as_the_servers_map(self):
+        """The DEM's bytes with its sidecar preview like the map made from the same file."""
+        with open(DEM, "rb") as f:
+            content = base64.b64encode(f.read()).decode()
+        with open(os.path.splitext(DEM)[0] + ".json") as f:
+            sidecar = f.read()
+        region = [0.1, 0.2, 0.8, 0.9]
+        answers = []
+        for goal in ({"file": {"name": "volcano.csv", "content_b64": content, "sidecar_json": sidecar}, "region": region},
+                     {"map": "volcano", "region": region}):
+            status, data = self.call("POST", "/api/preview", {"rows": 3, "cols": 4, "goal": goal}, token=TOKENS["preview"])
+            self.assertEqual(status, 200, data)
+            answers.append(json.loads(data))
+        self.assertEqual(answers[0]["goal_heights_mm"], answers[1]["goal_heights_mm"])
+        self.assertEqual(answers[0]["correlation"], answers[1]["correlation"])
+
+    def test_a_mesh_goal_previews(self):
+        with open(os.path.join(SHARED, "data", "mesh", "openscad_letterblock.stl"), "rb") as f:
+            content = base64.b64encode(f.read()).decode()
+        status, data = self.call("POST", "/api/preview", {"rows": 3, "cols": 4, "goal": {
+            "file": {"name": "block.stl", "content_b64": content}}}, token=TOKENS["preview"])
+        self.assertEqual(status, 200, data)
+        self.assertEqual(len(json.loads(data)["predicted"]["heights_mm"]), 7 * 9)
 
 
 if __name__ == "__main__":
