@@ -90,9 +90,12 @@ def dataset_from_json(doc):
 
 
 def calibration_options_from_json(doc):
+    effects = optional(doc, "effects", list, [], "options")
+    if not all(isinstance(e, str) for e in effects):
+        raise BadRequest("options.effects must be a list of effect names")
     options = _calibration_options(
         params_json=optional(doc, "params_json", str, "", "options"),
-        effects=optional(doc, "effects", list, [], "options"),
+        effects=effects,
         segments=optional(doc, "segments", int, 0, "options"),
         max_iterations=optional(doc, "max_iterations", int, 0, "options"))
     return options

@@ -191,8 +191,10 @@ class Handler(BaseHTTPRequestHandler):
             self.send_json(http_status(e.code), error_body(e.call, e.code, e.details))
         except grpc.RpcError as e:
             self.send_json(http_status(e.code()), error_body(path, e.code(), e.details()))
-        except ValueError as e:
+        except ValueError as e:  # protobuf's own checks, e.g. a number out of an int32's range
             self.send_json(400, error_body(path, "INVALID_ARGUMENT", str(e)))
+        except Exception as e:  # a bug here: say so in words rather than drop the connection
+            self.send_json(500, error_body(path, "INTERNAL", f"the gateway failed: {type(e).__name__}: {e}"))
 
     def map_file(self, rest):
         """/api/maps/NAME/file: the map's bytes; /api/maps/NAME/sidecar: its NAME.json ({} if none)."""

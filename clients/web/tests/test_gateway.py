@@ -64,6 +64,15 @@ class GatewayTest(unittest.TestCase):
         self.assertEqual(status, 400)
         self.assertIn("goal.file.content_b64 is not base64", json.loads(data)["error"]["message"])
 
+    def test_out_of_range_numbers_and_wrong_lists_are_bad_requests(self):
+        status, data = self.call("POST", "/api/preview", {"rows": 1 << 40, "cols": 4, "goal": {"map": "volcano"}},
+                                 token=TOKENS["preview"])
+        self.assertEqual(status, 400, data)
+        status, data = self.call("POST", "/api/calibration/compare", {"dataset": "demo-two", "options": {"effects": [1]}},
+                                 token=TOKENS["preview"])
+        self.assertEqual(status, 400, data)
+        self.assertIn("options.effects", json.loads(data)["error"]["message"])
+
     def test_api_calls_without_the_pages_header_are_refused(self):
         status, data = self.call("POST", "/api/device/stop", {}, token=TOKENS["admin"], api_header=False)
         self.assertEqual(status, 403)
