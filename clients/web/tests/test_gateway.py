@@ -5,9 +5,14 @@ import base64
 import http.client
 import json
 import os
+import re
+import signal
+import subprocess
+import tempfile
+import time
 import unittest
 
-from rig import DEM, SHARED, TOKENS, Stack
+from rig import DEM, SERVER, SHARED, TOKENS, Stack
 
 
 class GatewayTest(unittest.TestCase):
@@ -116,6 +121,41 @@ class GatewayTest(unittest.TestCase):
             "file": {"name": "block.stl", "content_b64": content}}}, token=TOKENS["preview"])
         self.assertEqual(status, 200, data)
         self.assertEqual(len(json.loads(data)["predicted"]["heights_mm"]), 7 * 9)
+
+
+class ServerHttpFlagTest(unittest.TestCase):
+    """hapticjam-server --http starts the gateway beside itself and stops it on shutdown."""
+
+    def test_the_server_serves_the_viewer_and_takes_it_down_with_it(self):
+        folder = tempfile.mkdtemp(prefix="hj_web_http_")
+        server = subprocess.Popen([SERVER, "--listen", "127.0.0.1:0", "--db", os.path.join(folder, "queue.db"),
+                                   "--map", f"volcano={DEM}", "--http", "127.0.0.1:0"],
+                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        try:
+            port = None
+            deadline = time.monotonic() + 60
+            while port is None and time.monotonic() < deadline:
+                m = re.search(r"hapticjam-web listening on http://127\.0\.0\.1:(\d+)/", server.stdout.readline())
+                port = int(m.group(1)) if m else None
+            self.assertIsNotNone(port, "no address from the viewer")
+            connection = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+            connection.request("GET", "/api/info", headers={"X-Hapticjam-Web": "1"})
+            info = json.loads(connection.getresponse().read())
+            connection.close()
+            self.assertEqual(info["maps"], ["volcano"])
+            self.assertEqual(list(info["map_files"]), ["volcano"])
+        finally:
+            server.send_signal(signal.SIGTERM)
+            self.assertEqual(server.wait(timeout=30), 0)
+            server.stdout.close()
+        with self.assertRaises(OSError):  # the gateway went with it
+            http.client.HTTPConnection("127.0.0.1", port, timeout=5).request("GET", "/")
+
+    def test_http_off_loopback_needs_auth(self):
+        out = subprocess.run([SERVER, "--listen", "127.0.0.1:0", "--http", "0.0.0.0:8080"], capture_output=True,
+                             text=True, timeout=30)
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("--http 0.0.0.0:8080 is not a loopback address", out.stderr)
 
 
 if __name__ == "__main__":
