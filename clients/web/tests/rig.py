@@ -4,6 +4,7 @@ each printing its port; stopped by close()."""
 
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -43,11 +44,11 @@ class Stack:
         auth = os.path.join(self.folder, "auth")
         with open(auth, "w") as f:
             f.write("alice operator token-alice\nviewer preview token-viewer\nroot admin token-root\n")
-        # Two cheap sessions of demo-baseline as the Workbench's dataset.
+        # Two cheap sessions of demo-baseline as the Workbench's dataset (copies: a browser does not follow links).
         self.dataset = os.path.join(self.folder, "demo-two")
         os.makedirs(self.dataset)
         for name in ("unjammed-sweep", "mixed-1"):
-            os.symlink(os.path.join(DEMO_BASELINE, name), os.path.join(self.dataset, name))
+            shutil.copytree(os.path.join(DEMO_BASELINE, name), os.path.join(self.dataset, name))
         self.processes = []
         emulator, emulator_port = start([EMULATOR, "--listen", "127.0.0.1:0", "--rows", "3", "--cols", "4"],
                                         self.folder, "emulator", r"listening on 127\.0\.0\.1:(\d+)")

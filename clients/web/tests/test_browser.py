@@ -200,6 +200,17 @@ class BrowserTest(unittest.TestCase):
         self.assertIn("PERMISSION_DENIED", self.by_id("bench-error").text)
         self.assertIn("needs operator", self.by_id("bench-error").text)
 
+    def test_7_a_folder_chosen_in_the_browser_is_uploaded_and_compared(self):
+        self.open("workbench", TOKENS["preview"])
+        # Chromium takes a folder path for a webkitdirectory input.
+        self.by_id("bench-folder").send_keys(self.stack.dataset)
+        self.assertTrue(self.browser.find_element(By.CSS_SELECTOR, "input[name=dataset-source][value=upload]").is_selected())
+        self.browser.find_element(By.CSS_SELECTOR, "[data-run=compare]").click()
+        self.wait(lambda: self.by_id("bench-result").is_displayed() or self.by_id("bench-error").is_displayed(),
+                  what="the comparison")
+        self.assertFalse(self.by_id("bench-error").is_displayed(), self.by_id("bench-error").text)
+        self.assertIn("demo-two", self.browser.execute_script("return document.getElementById('bench-report').srcdoc"))
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
