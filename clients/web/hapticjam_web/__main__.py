@@ -55,7 +55,7 @@ def main(argv=None):
         print(f"hapticjam-web: no three.js in {args.three_dir} (apt-get install libjs-three); "
               "the pages draw surfaces on a 2-D canvas instead", file=sys.stderr)
     gateway = Gateway(args.server, maps=dict(args.map), datasets=dict(args.dataset))
-    server = make_server(gateway, args.host, args.port, args.three_dir)
+    server = make_server(gateway, args.host, args.port, args.three_dir, loopback_only=not args.allow_remote)
     host = args.host if ":" not in args.host else f"[{args.host}]"
     print(f"hapticjam-web listening on http://{host}:{server.server_address[1]}/ (server {args.server})", flush=True)
     try:

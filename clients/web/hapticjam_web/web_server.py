@@ -20,6 +20,7 @@ from .http_errors import error_body, http_status
 STATIC_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "static")
 THREE_DIR = "/usr/share/javascript/three"  # Debian: libjs-three
 MAX_BODY_BYTES = 96 << 20  # a 64 MiB goal, base64-encoded
+LOOPBACK_NAMES = {"127.0.0.1", "localhost", "[::1]"}
 # Pages send this header with every API call: a plain cross-site form cannot,
 # so another site open in the same browser cannot drive the device.
 API_HEADER = "X-Hapticjam-Web"
@@ -67,6 +68,7 @@ def cancel_when_client_leaves(connection, call, done):
 class Handler(BaseHTTPRequestHandler):
     gateway = None      # set by make_server
     three_dir = THREE_DIR
+    loopback_only = True  # API calls must name a loopback Host (a DNS-rebinding page names its own)
     protocol_version = "HTTP/1.1"
 
     def log_message(self, fmt, *args):  # one short line per request on stderr
@@ -83,6 +85,11 @@ class Handler(BaseHTTPRequestHandler):
         self.send_header("Cache-Control", "no-store")
         self.end_headers()
         self.wfile.write(data)
+
+    def host_name(self):
+        """The Host header without its port ("[::1]:8080" -> "[::1]")."""
+        host = self.headers.get("Host", "")
+        return host if host.endswith("]") else host.rpartition(":")[0] or host
 
     def token(self):
         auth = self.headers.get("Authorization", "")
@@ -178,6 +185,9 @@ class Handler(BaseHTTPRequestHandler):
     def answer(self, path, routes, streams):
         if path not in routes and path not in streams:
             return self.send_json(404, error_body(path, "NOT_FOUND", f"no route {self.command} {path}"))
+        if self.loopback_only and self.host_name() not in LOOPBACK_NAMES:
+            return self.send_json(403, error_body(path, "FORBIDDEN", f"Host {self.headers.get('Host')!r}: this viewer "
+                                                                     "answers only to a loopback address"))
         if self.headers.get(API_HEADER) != "1":
             return self.send_json(403, error_body(path, "FORBIDDEN", f"API calls need the header {API_HEADER}: 1 "
                                                                      "(the pages send it)"))
@@ -210,8 +220,9 @@ class Handler(BaseHTTPRequestHandler):
         serve_file(self, os.path.dirname(path), os.path.basename(path))
 
 
-def make_server(gateway, host, port, three_dir=THREE_DIR):
-    handler = type("BoundHandler", (Handler,), {"gateway": gateway, "three_dir": three_dir})
+def make_server(gateway, host, port, three_dir=THREE_DIR, loopback_only=True):
+    handler = type("BoundHandler", (Handler,), {"gateway": gateway, "three_dir": three_dir,
+                                                "loopback_only": loopback_only})
     server = ThreadingHTTPServer((host, port), handler)
     server.daemon_threads = True
     return server

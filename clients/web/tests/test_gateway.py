@@ -25,9 +25,9 @@ class GatewayTest(unittest.TestCase):
     def tearDownClass(cls):
         cls.stack.close()
 
-    def call(self, method, path, body=None, token=None, api_header=True):
+    def call(self, method, path, body=None, token=None, api_header=True, host=None):
         connection = http.client.HTTPConnection(self.host, int(self.port), timeout=120)
-        headers = {"Content-Type": "application/json"}
+        headers = {"Content-Type": "application/json", "Host": host or f"{self.host}:{self.port}"}
         if api_header:
             headers["X-Hapticjam-Web"] = "1"
         if token:
@@ -82,6 +82,13 @@ class GatewayTest(unittest.TestCase):
         status, data = self.call("POST", "/api/device/stop", {}, token=TOKENS["admin"], api_header=False)
         self.assertEqual(status, 403)
         self.assertIn("X-Hapticjam-Web", json.loads(data)["error"]["message"])
+
+    def test_api_calls_naming_another_host_are_refused(self):
+        """A page of another site whose name was made to resolve to 127.0.0.1 sends its own name as Host."""
+        status, data = self.call("POST", "/api/device/stop", {}, token=TOKENS["admin"], host="evil.example:80")
+        self.assertEqual(status, 403)
+        self.assertIn("loopback", json.loads(data)["error"]["message"])
+        self.assertEqual(self.call("GET", "/api/info", token=TOKENS["preview"], host=f"localhost:{self.port}")[0], 200)
 
     def test_static_files_stay_inside_their_folders(self):
         self.assertEqual(self.call("GET", "/")[0], 200)
