@@ -10,6 +10,7 @@ packages=(
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   libopencv-dev libassimp-dev libsqlite3-dev libgdal-dev libceres-dev
   python3 python3-grpcio python3-protobuf openssl
+  libjs-three chromium chromium-driver python3-selenium
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -5,10 +5,13 @@
 # sees the device, then as a client: plans a real DEM with live progress and
 # streamed snapshots, sends the plan to the emulated device with a capture,
 # prints how far the captured surface is from the predicted one, zooms into
-# the DEM with the Python client (a repeat comes from the cache), and stops
-# both programs on exit, whatever happens.
+# the DEM with the Python client (a repeat comes from the cache), starts the
+# web viewer (clients/web, docs/web.md) and prints its address, and stops
+# every program on exit, whatever happens. HJ_DEMO_KEEP=1 keeps the stack up
+# after the demo, until Ctrl-C, to look around in the browser.
 #
 #   bash scripts/demo.sh [OUT_DIR]      (default hapticjam-demo-remote/)
+#   HJ_DEMO_KEEP=1 HJ_WEB_LISTEN=127.0.0.1:8080 bash scripts/demo.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-hapticjam-demo-remote}
@@ -70,8 +73,9 @@ for i in $(seq 100); do
 done
 "$HJ" remote status
 
-echo "== plan $DEM on the server (progress and snapshots streamed)"
-"$HJ" remote plan "$DEM" --rows $ROWS --cols $COLS --out "$OUT/plan" --snapshots
+echo "== plan $DEM (the server's map volcano) on the server (progress and snapshots streamed)"
+# The server's map of the DEM, so that the viewer's first page, asking the same, is answered from the cache.
+"$HJ" remote plan --map volcano --rows $ROWS --cols $COLS --out "$OUT/plan" --snapshots
 
 echo "== send the plan to the emulated device, capture, compare"
 "$HJ" remote submit "$OUT/plan/plan.json" --capture --wait --out "$OUT/device" --name "demo: volcano"
@@ -79,8 +83,22 @@ echo "== send the plan to the emulated device, capture, compare"
 
 PYTHON=/usr/bin/python3
 command -v "$PYTHON" >/dev/null || PYTHON=python3
+echo "== start the web viewer"
+PYTHONPATH="$BUILD/clients/python:clients/python:clients/web" "$PYTHON" -m hapticjam_web --server "$HAPTICJAM_SERVER" \
+  --listen "${HJ_WEB_LISTEN:-127.0.0.1:0}" --map volcano=$DEM --dataset demo-baseline=../shared/data/sessions/demo-baseline \
+  >"$LOGS/web.out" 2>"$LOGS/web.log" &
+pids+=($!)
+VIEWER=$(wait_for_line "$LOGS/web.out" 20 'listening on http://[^ ]+' "${pids[2]}" | sed -E 's/.*(http:[^ ]+).*/\1/')
+echo "viewer: ${VIEWER}#plan?map=volcano&rows=$ROWS&cols=$COLS&segments=0&auto=1 (the demo's plan; no token needed)"
+[ "${HJ_DEMO_KEEP:-0}" = 1 ] || echo "        (it stops with the demo; HJ_DEMO_KEEP=1 bash scripts/demo.sh keeps it up)"
+
 echo "== zoom into the DEM with the Python client (the last two regions come from the cache)"
 PYTHONPATH="$BUILD/clients/python:clients/python" "$PYTHON" clients/python/examples/map_zoom.py \
   --server "$HAPTICJAM_SERVER" --map volcano --rows $ROWS --cols $COLS
 
 echo "demo: done; plan, snapshots, captured frames and logs in $OUT/"
+if [ "${HJ_DEMO_KEEP:-0}" = 1 ]; then
+  echo "demo: HJ_DEMO_KEEP=1: the emulator, the server and the viewer stay up at ${VIEWER}; Ctrl-C stops them"
+  trap 'exit 0' INT TERM  # stopping them now is the plan, not a failure
+  wait "${pids[1]}"
+fi

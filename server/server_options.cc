@@ -9,7 +9,7 @@ const char* const kServerUsage =
     "usage: hapticjam-server --listen HOST:PORT [--device HOST:PORT|SERIAL] [--workers N]\n"
     "                        [--auth FILE] [--db FILE] [--tls-cert F --tls-key F]\n"
     "                        [--map NAME=FILE ...] [--queue-size N] [--device-queue-size N]\n"
-    "                        [--cache-size N] [--max-message-mib N]\n"
+    "                        [--cache-size N] [--max-message-mib N] [--http HOST:PORT]\n"
     "The hapticjam gRPC server (proto/hapticjam/v1): planning on a pool of simulator\n"
     "workers, and a persistent queue of jobs for the attached array.\n"
     "  --listen HOST:PORT      address to serve on; port 0 picks a free port (printed).\n"
@@ -29,6 +29,9 @@ const char* const kServerUsage =
     "  --device-queue-size N   device jobs that may wait (default 64)\n"
     "  --cache-size N          planning results kept for repeated requests (default 256, 0 = off)\n"
     "  --max-message-mib N     largest request accepted (default 64 MiB)\n"
+    "  --http HOST:PORT        also serve the web viewer there (clients/web, docs/web.md):\n"
+    "                          a gateway process over this server's gRPC API; loopback\n"
+    "                          only without --auth; port 0 picks one (printed)\n"
     "  --help                  this text\n"
     "Logs: one JSON object per line on stderr. SIGINT/SIGTERM shut down cleanly.\n";
 
@@ -83,6 +86,7 @@ ServerOptions parse_server_args(const std::vector<std::string>& args, bool* help
     } else if (a == "--queue-size") out.queue_size = parse_count(a, v, 0, 100'000);
     else if (a == "--device-queue-size") out.device_queue_size = parse_count(a, v, 1, 1'000'000);
     else if (a == "--cache-size") out.cache_size = parse_count(a, v, 0, 1'000'000);
+    else if (a == "--http") out.http = v;
     else if (a == "--max-message-mib") out.limits.max_message_bytes = parse_count(a, v, 1, 1024) << 20;
     else throw std::invalid_argument("unknown option " + a + " (see --help)");
   }
@@ -98,6 +102,15 @@ void ServerOptions::validate() const {
                                 " is not a loopback address: without --auth the server lets every caller do "
                                 "everything, so it listens only on 127.0.0.1, localhost or [::1]; give --auth FILE");
   if (tls_cert.empty() != tls_key.empty()) throw std::invalid_argument("--tls-cert and --tls-key go together");
+  if (!http.empty()) {
+    if (http.rfind(':') == std::string::npos) throw std::invalid_argument("--http needs HOST:PORT, got \"" + http + "\"");
+    if (auth_file.empty() && !is_loopback_listen(http))
+      throw std::invalid_argument("--http " + http + " is not a loopback address: without --auth every caller may do "
+                                  "everything; give --auth FILE");
+    if (!tls_cert.empty())
+      throw std::invalid_argument("--http with --tls-cert: the viewer's gateway speaks plaintext gRPC; start "
+                                  "hapticjam-web by itself (docs/web.md)");
+  }
   if (workers < 0) throw std::invalid_argument("--workers must be at least 1");
   if (db_file.empty()) throw std::invalid_argument("--db needs a file name");
 }

@@ -22,10 +22,12 @@ struct ServerOptions {
   int queue_size = 16;                // planning requests that may wait for a worker
   int device_queue_size = 64;         // device jobs that may wait
   int cache_size = 256;               // planning results kept
+  std::string http;                   // HOST:PORT of the web viewer (clients/web, docs/web.md); "" = none
   ServerLimits limits;
 
   // Throws std::invalid_argument naming the flag: no --listen, a non-loopback
-  // --listen without --auth, half of the TLS pair, a count out of range.
+  // --listen or --http without --auth, half of the TLS pair, --http with TLS,
+  // a count out of range.
   void validate() const;
   int worker_count() const;  // workers, or the core count
 };
