@@ -41,10 +41,9 @@ struct StaticSolverOptions {
   int push_iterations = 20;
   // The careful controls give up after this many iterations in which the
   // residual has not halved: there is nothing to converge to (the model
-  // has no equilibrium there, e.g. a fold, issue 3), and the remaining
-  // budget would only make the failure slow. Over the test suite the
-  // longest such stretch of a settle that converged was 366 iterations; of
-  // the ones that failed, 176 of 207 never halved in their last 900.
+  // has no equilibrium there, e.g. a fold), and the remaining budget would
+  // only make the failure slow. Set well above the longest such stretch of
+  // a settle that converges.
   int stall_iterations = 500;
   bool check_stability = true;
   // Settle a mirror-symmetric state (mirror_symmetry.h: a free net under
