@@ -27,26 +27,6 @@ constexpr int kPushRefusals = 2;
 // Overlap above which a divergence mode is the one already known.
 constexpr double kSameMode = 0.9;
 
-// Bends the step v along the curve the forces follow (geodesic
-// acceleration, Transtrum & Sethna 2012): F'' along v from one probe at
-// h v, a = (K + mu I)^-1 F'', step v + a / 2. Jammed cells are ~1000 times
-// stiffer in bending than the net is in stretch, so a straight step that
-// turns a jammed cell loads its springs at second order and the linear
-// model fails even for small steps. Skipped where the correction is not small.
-void add_geodesic_acceleration(const ForceModel& model, const DeviceState& state, const StepSystem& system,
-                               ShiftedSolver& solver, double mu, const Eigen::VectorXd& residual,
-                               Eigen::VectorXd& step) {
-  constexpr double kProbe = 0.1, kMaxRatio = 0.75;
-  Eigen::Matrix3Xd f_probe;
-  model.forces(state, state.x + system.scatter(kProbe * step), f_probe);
-  // F(x + h v) = F - h K v + h^2 F''/2, and K v = F - mu v.
-  const Eigen::VectorXd second =
-      (2.0 / (kProbe * kProbe)) * (system.gather(f_probe) - residual + kProbe * (residual - mu * step));
-  Eigen::VectorXd accel;
-  if (!solver.solve_again(system.matrix(), mu, second, accel) || !accel.allFinite()) return;
-  if (2.0 * accel.norm() <= kMaxRatio * step.norm()) step += 0.5 * accel;
-}
-
 // run_continuation's loop and its state, each stage of a step in its own
 // method.
 class Continuation {
@@ -77,7 +57,6 @@ class Continuation {
   std::optional<Trial> trial_step();
   Verdict judge_displacement(const Trial& trial);
   Verdict judge_model_trust(const Trial& trial);
-  Verdict judge_curved(const Trial& trial);
   void accept(Trial& trial);
   void settle_for_pushed_from();
   MirrorGroup symmetry();
@@ -266,9 +245,8 @@ bool Continuation::take_step() {
     mu_ = std::max(4.0 * mu_, mu0_);
     return false;
   }
-  const Verdict verdict = control_ == StepControl::kDisplacement ? judge_displacement(*trial)
-                          : control_ == StepControl::kModelTrust ? judge_model_trust(*trial)
-                                                                 : judge_curved(*trial);
+  const Verdict verdict =
+      control_ == StepControl::kDisplacement ? judge_displacement(*trial) : judge_model_trust(*trial);
   if (verdict == Verdict::kAccept) accept(*trial);
   return verdict == Verdict::kStop;
 }
@@ -286,8 +264,6 @@ std::optional<Continuation::Trial> Continuation::trial_step() {
                              ? active_->scatter(trial.full_step).colwise().norm().maxCoeff()
                              : NAN;
   if (!std::isfinite(largest)) return std::nullopt;
-  if (control_ == StepControl::kCurvedModelTrust)
-    add_geodesic_acceleration(model_, state_, *active_, *active_solver_, mu_, residual_, trial.full_step);
   const Eigen::Matrix3Xd move = active_->scatter(trial.full_step);
   trial.scale = std::min(1.0, max_step_ / move.colwise().norm().maxCoeff());
   trial.x = state_.x + trial.scale * move;
@@ -346,25 +322,6 @@ Continuation::Verdict Continuation::judge_model_trust(const Trial& trial) {
     mu_ = std::max(mu_, 2.0 * refused_mu_);
     refused_mu_ *= 0.5;
   }
-  return Verdict::kAccept;
-}
-
-// The same in the plain norm, for the curved steps (whose bend the linear
-// model does not include).
-Continuation::Verdict Continuation::judge_curved(const Trial& trial) {
-  const double scale = trial.scale;
-  const Eigen::VectorXd predicted = (1.0 - scale) * residual_ + (scale * mu_) * trial.full_step;
-  const double rho = (trial.residual - predicted).norm() / std::max((residual_ - predicted).norm(), 1e-300);
-  if (rho > 1.0 && !(trial.new_norm < trial.old_norm)) {
-    mu_ = std::max(4.0 * mu_, mu0_);
-    return Verdict::kRefuse;
-  }
-  if (rho < 0.1)
-    mu_ *= 0.1;
-  else if (rho < 0.3)
-    mu_ *= 0.3;
-  else if (rho < 1.0 || trial.new_norm < 0.9 * trial.old_norm)
-    mu_ *= 0.7;
   return Verdict::kAccept;
 }
 

@@ -30,9 +30,6 @@ enum class StepControl {
   // (rho below), and grows when it fails: slower, but it holds on stiff
   // jammed cells whose rotation the linear model gets wrong.
   kModelTrust,
-  // kModelTrust with each step bent by its geodesic acceleration: the
-  // rescue where the careful control does not settle.
-  kCurvedModelTrust,
 };
 
 // Iterates from state.x; returns with report.converged set when a stable

@@ -110,15 +110,6 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
   if (!report.converged)
     run_continuation(model, state, k, system, solver, fixed, options, StepControl::kModelTrust, options.max_iterations,
                      mu0, remembered, report);
-  // The curved steps change which of two nearby equilibria a settle finds
-  // in some cases that settle without them, so they are the last resort,
-  // not the default.
-  if (!report.converged) {
-    state.x = start_x;
-    report.restarts = 0;
-    run_continuation(model, state, k, system, solver, fixed, options, StepControl::kCurvedModelTrust,
-                     options.max_iterations, mu0, remembered, report);
-  }
   report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return report;
 }
