@@ -16,7 +16,7 @@ namespace v1 = ::hapticjam::v1;
 using Clock = std::chrono::steady_clock;
 
 // Preview's mesh when the request leaves array.segments unset: planning
-// time grows steeply with the segments (6 x 8 cells: ~2 s at 2, minutes at 4).
+// time grows steeply with the segments (6 x 8 cells: seconds at 2, minutes at 4).
 constexpr int kPreviewSegments = 2;
 
 namespace {

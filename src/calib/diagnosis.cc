@@ -229,13 +229,25 @@ double noise_floor_mm(const Dataset& dataset) {
                    s.sensor_resolution_mm * s.sensor_resolution_mm / 12.0);
 }
 
-Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const DiagnoseOptions& options,
-                   const DiagnoseProgress& progress) {
-  Diagnosis out;
-  out.noise_floor_mm = noise_floor_mm(dataset);
-  const ReplayOptions& replay = options.fit.least_squares.replay;
+namespace {
 
-  // The baseline, fitted the paper's way then jointly.
+// The greedy forward selection diagnose() runs: the effects chosen so far
+// and the fit of the model they make, against which candidates are judged.
+struct Selection {
+  const Dataset& dataset;
+  const DiagnoseOptions& options;
+  const DiagnoseProgress& progress;
+  Diagnosis& out;
+  std::vector<std::string> chosen;
+  LeastSquaresResult current;
+  double current_heldout = 0.0;
+};
+
+// The baseline, fitted the paper's way then jointly, its held-out RMSE, the
+// ladder's first step and where its residual concentrates.
+void fit_baseline(const Dataset& dataset, const ModelParams& start, const DiagnoseOptions& options,
+                  const DiagnoseProgress& progress, Diagnosis& out) {
+  const ReplayOptions& replay = options.fit.least_squares.replay;
   ModelParams base_start = start;
   base_start.effects.clear();
   base_start.effect_parameters.clear();
@@ -250,168 +262,212 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   if (progress) progress("residual pattern", 0, 1, "");
   out.pattern = describe_residuals(dataset, evaluate_dataset(dataset, out.baseline.joint.params, replay));
   if (progress) progress("residual pattern", 1, 1, "");
+}
 
-  // Greedy forward selection: each round adds the significant candidate
-  // with the lowest held-out error to the current model.
-  std::vector<std::string> chosen;
-  LeastSquaresResult current = out.baseline.joint;
-  double current_heldout = out.baseline_heldout_rmse_mm;
-  std::vector<std::string> remaining = candidate_effects(options);
-  for (int round = 0; round < options.max_effects && !remaining.empty(); ++round) {
-    std::vector<CandidateFit> fits, to_refit;
-    std::string on;
-    for (const auto& e : chosen) on += " + " + e;
-    for (const auto& effect : remaining) {
-      CandidateFit c;
-      c.effects = chosen;
-      c.effects.push_back(effect);
-      c.added = effect;
-      const auto parameters = fit_parameters(c.effects);
-      if (options.scan) {
-        if (progress) progress("scan " + effect, 0, 1, "");
-        try {
-          EffectScan scan = scan_effect_start(dataset, with_effects(current.params, c.effects), parameters, effect,
-                                              replay, options.scan_options);
-          c.scan_rmse_mm = std::sqrt(scan.best_sum_sq_mm2 / std::max(current.residual_count, 1L));
-          if (scan.moved) {
-            c.scanned_start = std::move(scan.best);
-            c.scan_note = scan.note;
-          }
-        } catch (const SettleInterrupted&) {
-          throw;  // the caller stopped the work: not a failed replay
-        } catch (const std::exception&) {
-          // The defaults do not replay: the starts below say what does.
-        }
-        if (progress) progress("scan " + effect, 1, 1, c.scan_note);
-      }
-      if (options.screening) {
-        if (progress) progress("screening " + effect, 0, 1, "");
-        const bool out_of_the_running = screen_out(dataset, current, current_heldout, parameters, options, c);
-        if (progress) progress("screening " + effect, 1, 1, out_of_the_running ? "screened out" : "refit");
-        if (out_of_the_running) {
-          fits.push_back(std::move(c));
-          continue;
-        }
-      }
-      to_refit.push_back(std::move(c));
+// The candidate that adds `effect` to the chosen ones, its start moved by
+// the scan (effect_scan.h) where that found a better one.
+CandidateFit scanned_candidate(const Selection& s, const std::string& effect) {
+  CandidateFit c;
+  c.effects = s.chosen;
+  c.effects.push_back(effect);
+  c.added = effect;
+  if (!s.options.scan) return c;
+  const auto parameters = fit_parameters(c.effects);
+  if (s.progress) s.progress("scan " + effect, 0, 1, "");
+  try {
+    EffectScan scan = scan_effect_start(s.dataset, with_effects(s.current.params, c.effects), parameters, effect,
+                                        s.options.fit.least_squares.replay, s.options.scan_options);
+    c.scan_rmse_mm = std::sqrt(scan.best_sum_sq_mm2 / std::max(s.current.residual_count, 1L));
+    if (scan.moved) {
+      c.scanned_start = std::move(scan.best);
+      c.scan_note = scan.note;
     }
-    // The most promising first, so that a candidate that cannot come near
-    // the best refitted one need not be refitted (refit_cutoff).
-    std::stable_sort(to_refit.begin(), to_refit.end(), [](const CandidateFit& a, const CandidateFit& b) {
-      return expected_rmse(a) < expected_rmse(b);
-    });
-    double best_heldout = std::numeric_limits<double>::infinity();
-    for (CandidateFit& c : to_refit) {
-      const std::string& effect = c.added;
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
+  } catch (const std::exception&) {
+    // The defaults do not replay: the starts below say what does.
+  }
+  if (s.progress) s.progress("scan " + effect, 1, 1, c.scan_note);
+  return c;
+}
+
+// Scans and screens each remaining effect: those the screening keeps out go
+// to `fits` with their predicted figures, the others to `to_refit`.
+void scan_and_screen(const Selection& s, const std::vector<std::string>& remaining, std::vector<CandidateFit>& fits,
+                     std::vector<CandidateFit>& to_refit) {
+  for (const auto& effect : remaining) {
+    CandidateFit c = scanned_candidate(s, effect);
+    if (s.options.screening) {
       const auto parameters = fit_parameters(c.effects);
-      if (options.screening && options.refit_cutoff > 0.0 && expected_rmse(c) > options.refit_cutoff * best_heldout) {
-        outrun(c, current, best_heldout, fits.front().added);
+      if (s.progress) s.progress("screening " + effect, 0, 1, "");
+      const bool out_of_the_running = screen_out(s.dataset, s.current, s.current_heldout, parameters, s.options, c);
+      if (s.progress) s.progress("screening " + effect, 1, 1, out_of_the_running ? "screened out" : "refit");
+      if (out_of_the_running) {
         fits.push_back(std::move(c));
         continue;
       }
-      // One progress stage per candidate, so that its time shows apart.
-      const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
-      // Warm start: the current model's optimum, the new effect where the
-      // scan found it best. A candidate the model cannot replay is skipped
-      // and said so.
-      try {
-        c.fit = fit_candidate(dataset, current.params, c, parameters, options,
-                              [&](int iteration, int max_iterations, double rmse) {
-                                if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
-                              });
-        if (progress) progress("cross-validation", 0, 1, effect);
-        c.heldout_rmse_mm = cross_validate(dataset, parameters, c.fit, replay).heldout_rmse_mm;
-        c.delta_bic = bic(c.fit) - bic(current);
-        c.significant = is_significant(c, current, current_heldout, options);
-      } catch (const SettleInterrupted&) {
-        throw;  // the caller stopped the work: not a failed replay
-      } catch (const std::exception& e) {
-        out.skipped.push_back(effect + ": " + e.what());
-        continue;
-      }
-      if (progress)
-        progress(stage, options.fit.least_squares.max_iterations, options.fit.least_squares.max_iterations,
-                 "held out " + std::to_string(c.heldout_rmse_mm) + " mm");
-      if (c.significant && c.heldout_rmse_mm < best_heldout) {
-        best_heldout = c.heldout_rmse_mm;
-        fits.insert(fits.begin(), std::move(c));  // fits.front(): the best significant refit so far
-      } else {
-        fits.push_back(std::move(c));
+    }
+    to_refit.push_back(std::move(c));
+  }
+}
+
+// Refits one candidate from the current optimum, cross-validates it and
+// judges it; false (and said so in out.skipped) if the model cannot replay it.
+bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
+  const std::string& effect = c.added;
+  const auto parameters = fit_parameters(c.effects);
+  // One progress stage per candidate, so that its time shows apart.
+  const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
+  const DiagnoseProgress& progress = s.progress;
+  // Warm start: the current model's optimum, the new effect where the scan
+  // found it best.
+  try {
+    c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options,
+                          [&](int iteration, int max_iterations, double rmse) {
+                            if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
+                          });
+    if (progress) progress("cross-validation", 0, 1, effect);
+    c.heldout_rmse_mm = cross_validate(s.dataset, parameters, c.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
+    c.delta_bic = bic(c.fit) - bic(s.current);
+    c.significant = is_significant(c, s.current, s.current_heldout, s.options);
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
+  } catch (const std::exception& e) {
+    s.out.skipped.push_back(effect + ": " + e.what());
+    return false;
+  }
+  if (progress)
+    progress(stage, s.options.fit.least_squares.max_iterations, s.options.fit.least_squares.max_iterations,
+             "held out " + std::to_string(c.heldout_rmse_mm) + " mm");
+  return true;
+}
+
+// Refits the candidates the screening let through, the most promising
+// first, so that one that cannot come near the best refitted one need not
+// be refitted (refit_cutoff). fits.front() is the best significant refit.
+void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits) {
+  std::string on;
+  for (const auto& e : s.chosen) on += " + " + e;
+  std::stable_sort(to_refit.begin(), to_refit.end(), [](const CandidateFit& a, const CandidateFit& b) {
+    return expected_rmse(a) < expected_rmse(b);
+  });
+  double best_heldout = std::numeric_limits<double>::infinity();
+  for (CandidateFit& c : to_refit) {
+    if (s.options.screening && s.options.refit_cutoff > 0.0 &&
+        expected_rmse(c) > s.options.refit_cutoff * best_heldout) {
+      outrun(c, s.current, best_heldout, fits.front().added);
+      fits.push_back(std::move(c));
+      continue;
+    }
+    if (!refit_candidate(s, on, c)) continue;
+    if (c.significant && c.heldout_rmse_mm < best_heldout) {
+      best_heldout = c.heldout_rmse_mm;
+      fits.insert(fits.begin(), std::move(c));
+    } else {
+      fits.push_back(std::move(c));
+    }
+  }
+}
+
+// Like with like (like_with_like.h): a candidate's optimum with its effect
+// switched off may fit better than the current model's own optimum; then
+// the current model is refitted from there and every candidate judged
+// against that. Each refitted candidate that lowered the in-sample RMSE by
+// min_fit_gain is checked (one replay), the lowest first, significant or
+// not; two refits at most a round.
+void recheck_like_with_like(Selection& s, int round, std::vector<CandidateFit>& fits) {
+  std::vector<std::string> rechecked;
+  for (int refits = 0; refits < 2;) {
+    const CandidateFit* next = nullptr;
+    for (const CandidateFit& c : fits)
+      if (!c.screened_out && c.fit.rmse_mm <= (1.0 - s.options.min_fit_gain) * s.current.rmse_mm &&
+          std::find(rechecked.begin(), rechecked.end(), c.added) == rechecked.end() &&
+          (!next || c.fit.rmse_mm < next->fit.rmse_mm))
+        next = &c;
+    if (!next) break;
+    rechecked.push_back(next->added);
+    if (!recheck_current(s.dataset, s.options, round, *next, s.chosen, s.progress, s.out, s.current,
+                         s.current_heldout))
+      continue;
+    ++refits;
+    const std::string why = "not significant against the current model refitted from " + next->added + "'s optimum";
+    // Every refitted candidate's delta BIC is against the model it extends,
+    // so against this fit now; one that was not significant cannot become
+    // so against a better fit.
+    for (CandidateFit& c : fits) {
+      if (c.screened_out) continue;  // predicted figures: kept as predicted
+      c.delta_bic = bic(c.fit) - bic(s.current);
+      if (c.significant) {
+        c.significant = is_significant(c, s.current, s.current_heldout, s.options);
+        if (!c.significant) c.recheck_note = why;
       }
     }
     rank(fits);
-    // Like with like (like_with_like.h): a candidate's optimum with its
-    // effect switched off may fit better than the current model's own
-    // optimum; then the current model is refitted from there and every
-    // candidate judged against that. Each refitted candidate that lowered
-    // the in-sample RMSE by min_fit_gain is checked (one replay), the
-    // lowest first, significant or not (synthetic bending + sensor_tilt:
-    // boundary_compliance's refit took the RMSE from 1.311 to 1.116 mm
-    // and was not significant held out); two refits at most a round.
-    std::vector<std::string> rechecked;
-    for (int refits = 0; refits < 2;) {
-      const CandidateFit* next = nullptr;
-      for (const CandidateFit& c : fits)
-        if (!c.screened_out && c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm &&
-            std::find(rechecked.begin(), rechecked.end(), c.added) == rechecked.end() &&
-            (!next || c.fit.rmse_mm < next->fit.rmse_mm))
-          next = &c;
-      if (!next) break;
-      rechecked.push_back(next->added);
-      if (!recheck_current(dataset, options, round, *next, chosen, progress, out, current, current_heldout)) continue;
-      ++refits;
-      const std::string why = "not significant against the current model refitted from " + next->added + "'s optimum";
-      // Every refitted candidate's delta BIC is against the model it
-      // extends, so against this fit now; one that was not significant
-      // cannot become so against a better fit.
-      for (CandidateFit& c : fits) {
-        if (c.screened_out) continue;  // predicted figures: kept as predicted
-        c.delta_bic = bic(c.fit) - bic(current);
-        if (c.significant) {
-          c.significant = is_significant(c, current, current_heldout, options);
-          if (!c.significant) c.recheck_note = why;
-        }
-      }
-      rank(fits);
-    }
-    const bool chosen_one = !fits.empty() && fits.front().significant;
-    if (chosen_one) {
-      // The next round is judged against this fit: it must have converged
-      // (the ranking shows it so, as the final parameters are).
-      CandidateFit& best = fits.front();
-      std::string label = "baseline";
-      for (const auto& e : best.effects) label += " + " + e;
-      const auto best_parameters = fit_parameters(best.effects);
-      if (converge(dataset, best_parameters, options, label, progress, best.fit, out.notes)) {
-        best.heldout_rmse_mm = cross_validate(dataset, best_parameters, best.fit, replay).heldout_rmse_mm;
-        best.delta_bic = bic(best.fit) - bic(current);
-      }
-      note_gain_in_one_capture(dataset, current, best, out.notes);
-    }
+  }
+}
+
+// The round's choice, fits.front() if significant: the next round is judged
+// against its fit, so it must have converged (the ranking shows it so, as
+// the final parameters are). False if the round chose nothing.
+bool converge_choice(Selection& s, std::vector<CandidateFit>& fits) {
+  if (fits.empty() || !fits.front().significant) return false;
+  CandidateFit& best = fits.front();
+  std::string label = "baseline";
+  for (const auto& e : best.effects) label += " + " + e;
+  const auto best_parameters = fit_parameters(best.effects);
+  if (converge(s.dataset, best_parameters, s.options, label, s.progress, best.fit, s.out.notes)) {
+    best.heldout_rmse_mm =
+        cross_validate(s.dataset, best_parameters, best.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
+    best.delta_bic = bic(best.fit) - bic(s.current);
+  }
+  note_gain_in_one_capture(s.dataset, s.current, best, s.out.notes);
+  return true;
+}
+
+// The effects later rounds try: only those that lowered the held-out error
+// in this round, and one screened out only by the linearised folds'
+// held-out prediction whose predicted BIC beats the chosen effect's (that
+// prediction can be far off where the baseline absorbed the effect).
+std::vector<std::string> effects_for_next_round(const std::vector<CandidateFit>& fits, const CandidateFit& best,
+                                                double current_heldout) {
+  std::vector<std::string> next;
+  for (const auto& c : fits)
+    if (c.added != best.added && (c.heldout_rmse_mm < current_heldout ||
+                                  (c.screened_out && c.heldout_replayed && c.delta_bic < best.delta_bic)))
+      next.push_back(c.added);
+  return next;
+}
+
+}  // namespace
+
+Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const DiagnoseOptions& options,
+                   const DiagnoseProgress& progress) {
+  Diagnosis out;
+  out.noise_floor_mm = noise_floor_mm(dataset);
+  fit_baseline(dataset, start, options, progress, out);
+  // Greedy forward selection: each round adds the significant candidate
+  // with the lowest held-out error to the current model.
+  Selection s{dataset, options, progress, out, {}, out.baseline.joint, out.baseline_heldout_rmse_mm};
+  std::vector<std::string> remaining = candidate_effects(options);
+  for (int round = 0; round < options.max_effects && !remaining.empty(); ++round) {
+    std::vector<CandidateFit> fits, to_refit;
+    scan_and_screen(s, remaining, fits, to_refit);
+    refit_candidates(s, to_refit, fits);
+    rank(fits);
+    recheck_like_with_like(s, round, fits);
+    const bool chosen_one = converge_choice(s, fits);
     auto& record = round == 0 ? out.ranking : out.later_rounds;
     record.insert(record.end(), fits.begin(), fits.end());
     if (!chosen_one) break;
     const CandidateFit& best = fits.front();
-    // Later rounds try only the effects that lowered the held-out error in
-    // this round: one that did not help is not tried again. Except one
-    // screened out only by the linearised folds' held-out prediction whose
-    // predicted BIC beats the chosen effect's: that prediction can be far
-    // off (synthetic stiffening + cell_stiffness: cell_stiffness, delta BIC
-    // -11274 against stiffening's -3583, predicted 2.58 mm held out against
-    // the baseline's 1.60, refitted 1.53; found once stiffening is in).
-    std::vector<std::string> next;
-    for (const auto& c : fits)
-      if (c.added != best.added && (c.heldout_rmse_mm < current_heldout ||
-                                    (c.screened_out && c.heldout_replayed && c.delta_bic < best.delta_bic)))
-        next.push_back(c.added);
-    chosen.push_back(best.added);
-    current = best.fit;
-    current_heldout = best.heldout_rmse_mm;
+    remaining = effects_for_next_round(fits, best, s.current_heldout);
+    s.chosen.push_back(best.added);
+    s.current = best.fit;
+    s.current_heldout = best.heldout_rmse_mm;
     out.ladder.push_back({"+ " + best.added, best.fit.rmse_mm, best.heldout_rmse_mm});
-    remaining = next;
   }
-  out.verdict = chosen;
-  out.final_params = current.params;
+  out.verdict = s.chosen;
+  out.final_params = s.current.params;
   return out;
 }
 

@@ -29,9 +29,8 @@ struct DiagnoseOptions {
   double max_delta_bic = -10.0;
   // And the in-sample RMSE falls by at least this share too: a held-out
   // error that falls at an unchanged fit is the cross-validation folds'
-  // doing, not the data's (synthetic area_pressure, round 2: jam_creep,
-  // which does not move these frames, took the held-out RMSE from 1.647 to
-  // 1.105 mm at an in-sample 1.0399 -> 1.0394).
+  // doing, not the data's (on synthetic area_pressure data, jam_creep,
+  // which does not move those frames, lowered the held-out RMSE by a third).
   double min_fit_gain = 0.005;
   // Screening (screening.h): a candidate is refitted and cross-validated
   // only if its predicted held-out gain is at least screen_margin *
@@ -52,10 +51,9 @@ struct DiagnoseOptions {
   // the screening cannot predict, the RMSE at the scan's best point, where
   // the refit starts); one whose figure exceeds this many times the
   // held-out RMSE of a significant candidate already refitted in the round
-  // is not refitted (it could not be chosen over it). On demo-bending,
-  // bending's refit reaches 1.04 mm held out; the others are predicted at
-  // 2.4-2.7 mm and their refits (2.3-2.6 mm) cost 480 s CPU. 0, or
-  // screening off: refit every candidate that passes the screening.
+  // is not refitted (it could not be chosen over it, and its refit costs as
+  // much as the baseline fit). 0, or screening off: refit every candidate
+  // that passes the screening.
   double refit_cutoff = 2.0;
   EffectScanOptions scan_options;
   // A candidate whose predicted delta BIC passes but whose predicted

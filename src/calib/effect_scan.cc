@@ -30,11 +30,9 @@ struct DirectionResult {
 using PointCost = std::function<double(const ModelParams&)>;
 
 // Walks one direction, each point costed by `cost` (a replay of the
-// dataset, or a measurement effect's reused one). Replays are cold. Not
-// from the last point's states: the points are 3 x apart, and on
-// demo-baseline's bending scan a replay warm-started from the point before
-// took 17-53 s against 8-10 s cold (settles crawling from a far start) and
-// reached other equilibria.
+// dataset, or a measurement effect's reused one). Replays are cold, not
+// from the last point's states: the points are 3 x apart, and warm settles
+// crawl from that far start, slower than cold ones, some to other equilibria.
 DirectionResult walk(const ModelParams& start, const Direction& d, const EffectScanOptions& options,
                      const PointCost& cost) {
   DirectionResult out;
@@ -82,8 +80,8 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
   const int threads = replay.threads > 0 ? replay.threads : default_thread_count();
   // A point is only a candidate start, so one the static solver cannot
   // settle is stepped over at once rather than after the fallbacks (a
-  // failed replay with them: about 5 s at 3 x 4; most of a scan's time
-  // where the start sits next to a region with no equilibrium).
+  // failed replay with them is the costliest kind, and most of a scan's
+  // time where the start sits next to a region with no equilibrium).
   ReplayOptions point_replay = replay;
   point_replay.fallbacks = options.fallbacks;
   const int session_threads = std::max(1, threads / std::max(1, static_cast<int>(directions.size())));

@@ -85,8 +85,7 @@ std::string Emulator::act(std::uint64_t id, const Action& action) {
 // The safe state, one action at a time as a controller would: every pin
 // released, every cell unjammed, then the chamber vented. Both orders end
 // in the rest state, but this one settles far faster in the simulator
-// (from 0.8 kPa with two cells jammed and two nodes pinned: 48 ms, against
-// 3.4 s when the pressure goes first).
+// (venting first drags jammed plates and pinned nodes through the sag).
 std::string Emulator::vent(std::uint64_t id) {
   const Mesh& mesh = simulator_.mesh();
   std::vector<Action> steps;

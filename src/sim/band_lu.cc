@@ -64,10 +64,8 @@ std::vector<int> reverse_cuthill_mckee(const Graph& graph) {
 }
 
 // 4 n b^2 (a band LU's flops, b the half bandwidth) above which UMFPACK is
-// as fast. Measured 2026-11-25 (band against UMFPACK): 3 x 4, p = 6,
-// 3.0e7: 1.71 against 2.43 ms; 6 x 8, p = 4, 5.9e7: 4.27 against 4.78;
-// 3 x 4, p = 10, 2.2e8: 14.7 against 8.8; 9 x 12, p = 4, 2.8e8: 19.4
-// against 12.2.
+// as fast: the band LU wins at 3 x 4, p = 6 (3.0e7) and loses from
+// 3 x 4, p = 10 (2.2e8) and 9 x 12, p = 4 (2.8e8).
 constexpr double kMaxBandFlops = 4e7;
 
 }  // namespace

@@ -4,11 +4,8 @@
 // other last digits with 2 threads than with 1, and the server and the
 // tests load different BLAS builds). On the step matrices of small arrays
 // it factors and solves in a third to a half of UMFPACK's time, which there
-// goes into assembling and searching many small fronts, not arithmetic
-// (2026-11-25, K + I at 1 kPa with one cell jammed, min of 60: 3 x 4, p = 4,
-// 495 DOFs, half bandwidth 50: 0.30 against 0.95 ms; 4 x 6: 0.87 against
-// 1.98; demo-bending's jammed-sweep replayed: 1.08-1.30 -> 0.86-0.95 s). Its
-// cost grows as n b^2, so larger arrays keep UMFPACK (worthwhile()).
+// goes into assembling and searching many small fronts, not arithmetic.
+// Its cost grows as n b^2, so larger arrays keep UMFPACK (worthwhile()).
 #pragma once
 
 #include <Eigen/SparseCore>

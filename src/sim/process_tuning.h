@@ -10,8 +10,7 @@ namespace hj {
 //   large one to the kernel: a settle allocates and frees the same
 //   100 kB - 1 MB arrays every step (matrix, LU workspace), and with the
 //   default dynamic mmap threshold the kernel time to map and zero them
-//   matched the time spent computing (3 x 4 jammed sweep: 0.50 s user +
-//   0.15 s system -> 0.49 s + 0.00 s).
+//   can match the time spent computing.
 void tune_process_for_settling();
 
 }  // namespace hj

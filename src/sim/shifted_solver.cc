@@ -12,17 +12,15 @@ namespace {
 // Small systems factor in well under a millisecond: no point iterating.
 constexpr Eigen::Index kMinIterativeDofs = 1500;
 // BiCGSTAB budget; two matrix products an iteration. Past it the LU is
-// cheaper on the sizes above (measured on 9 x 12, p = 4).
+// cheaper on the sizes above.
 constexpr int kMaxIterations = 40;
 // Relative residual of the iterative solve: the Newton iteration corrects
 // the rest (an inexact Newton step).
 constexpr double kTolerance = 1e-8;
 // Below this shift, as a fraction of the mean |diagonal| of K + mu I, the
-// Jacobi-preconditioned iteration does not converge within its budget, so
-// it is not tried: on the 9 x 12, p = 4 settles from rest to 2 kPa it
-// converged at 0.07 (in one iteration) and ran out at 0.022, 9.3e-4 and
-// 4.3e-4, each failure 40 iterations (about 4 ms) thrown away before the
-// LU (2026-12-01: 84 -> 77 ms for the whole settle).
+// Jacobi-preconditioned iteration does not converge within its budget (on
+// a 9 x 12 settle it converged at 0.07 and ran out at 0.022 and below), so
+// it is not tried: each failure is 40 iterations thrown away before the LU.
 constexpr double kMinIterativeShift = 0.05;
 
 }  // namespace

@@ -32,12 +32,10 @@ struct SimulatorOptions {
   ImplicitFlowOptions flow_options;
   // Where the static solver's fast control does not settle, the implicit
   // flow (then polished by the static solver) before its careful controls:
-  // on large moves of jammed plates it is about twice as fast and reaches
-  // the same equilibria (demo-bending's all-jammed sweep at kappa_jam 7.25:
-  // 0 -> 431 Pa, 232 careful steps, 822 ms, against 42 flow steps and 3
-  // polishing ones, 369 ms; every pressure step of four sessions to 3e-6
-  // mm). Settles that must not use the fallbacks (Simulator::settle with
-  // fallbacks off) keep the careful controls.
+  // on large moves of jammed plates it takes far fewer steps and reaches
+  // the same equilibria (tests/flow_first_test.cc). Settles that must not
+  // use the fallbacks (Simulator::settle with fallbacks off) keep the
+  // careful controls.
   bool flow_first = true;
   // Steps the explicit fallback, the last resort after the flow, may take
   // before the settle is reported as failed (bounds the time of a hard
@@ -46,8 +44,8 @@ struct SimulatorOptions {
   // A jam at equilibrium only adds positive semi-definite stiffness
   // (phi_eq = phi) and a pin only removes DOFs: the state stays a stable
   // equilibrium, so their settle ends at once, without building K or
-  // checking stability, when the residual is already below tolerance
-  // (79 jams of a 9 x 12 plan cost about 3 s otherwise). Unjam and unpin
+  // checking stability, when the residual is already below tolerance (a
+  // planner jams and pins many times). Unjam and unpin
   // can destabilise and always settle in full.
   bool skip_settle_after_jam_or_pin = true;
   // A free net carried across levelling on a large mesh (at least 1,500

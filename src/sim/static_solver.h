@@ -3,14 +3,14 @@
 // flow c dx/dt = F(x),
 //   (K + mu I) dx = F,   K = -dF/dx (analytic, sparse), mu = c / dt,
 // so it starts as a heavily damped relaxation from the previous state and
-// ends as Newton. mu follows one of two controls (static_solver.cc): a fast
+// ends as Newton. mu follows one of two controls (continuation.cc): a fast
 // one that keeps each move near the cap, tried first (and given up once its
 // residual runs away), and a careful one that shrinks mu only while the
 // linear model predicts the residual, judged in the compliance-weighted
 // norm |(K + mu I)^-1 r| so the stiff springs of jammed cells do not veto
-// every step. Where that does not settle either, the careful one runs again
-// with curved steps (geodesic acceleration, for jammed cells turning on a
-// soft net). A converged
+// every step. Where neither settles, the settle reports converged = false
+// and the simulator's fallbacks take over (simulator.h: the implicit flow,
+// then explicit Euler). A converged
 // state along which K diverges (divergence_mode.h: a saddle, or the creased
 // net near levelling) is pushed along that mode and settled again; a push
 // that reaches no other equilibrium within push_iterations goes back, and
@@ -41,10 +41,9 @@ struct StaticSolverOptions {
   int push_iterations = 20;
   // The careful controls give up after this many iterations in which the
   // residual has not halved: there is nothing to converge to (the model
-  // has no equilibrium there, e.g. a fold, issue 3), and the remaining
-  // budget would only make the failure slow. Over the test suite the
-  // longest such stretch of a settle that converged was 366 iterations; of
-  // the ones that failed, 176 of 207 never halved in their last 900.
+  // has no equilibrium there, e.g. a fold), and the remaining budget would
+  // only make the failure slow. Set well above the longest such stretch of
+  // a settle that converges.
   int stall_iterations = 500;
   bool check_stability = true;
   // Settle a mirror-symmetric state (mirror_symmetry.h: a free net under

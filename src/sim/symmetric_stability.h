@@ -4,7 +4,7 @@
 // class onto itself (mirror_symmetry.h), so its eigenvectors lie in one
 // class each, and the inverse iteration needs the LU of that class's block
 // only: a quarter of the unknowns under both mirrors (9 x 12, p = 4: 1,213
-// to 1,254 a class, of 4,935; the 2 kPa dome's check 8.5 -> 2.6 ms).
+// to 1,254 a class, of 4,935).
 #pragma once
 
 #include <Eigen/Core>
