@@ -64,13 +64,15 @@ TEST(Portfolio, IsNeverBelowAlgorithm2AndSaysWhatItChose) {
 }
 
 TEST(RefusedActions, ADeadEndIsRecordedAndThePlanFinishes) {
-  // The volcano at 4 x 5 from rest: Algorithm 2 jams cells in the sag, and
-  // raising the pressure past them folds the net; those steps are refused.
-  const ArrayGeometry g{4, 5, 0.038, 4};
+  // The volcano at 5 x 8 from rest: Algorithm 2 jams cells in the 50 Pa
+  // sag, and raising the pressure past them folds the net (a dead end of
+  // the model, not of a solver budget); those steps are refused.
+  const ArrayGeometry g{5, 8, 0.038, 4};
   const Mesh mesh(g);
   const HeightMap volcano = import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
   const PlanRequest request{g, SurfaceParameters::paper_defaults(g), resample_to_mesh(volcano, mesh), {}, volcano.z};
   const PlanResult plan = make_planner("algorithm2")->plan(request);
+  ASSERT_FALSE(plan.refused.empty());
   for (const RefusedAction& r : plan.refused) {
     EXPECT_EQ(r.action.op, Action::Op::kSetPressure) << r.action.describe();
     EXPECT_FALSE(r.reason.empty());
