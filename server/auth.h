@@ -41,6 +41,8 @@ class Authenticator {
   Caller authorize(const std::optional<std::string>& authorization, Role role, const std::string& action) const;
 
  private:
+  const Caller* match_token(const std::string& token) const;
+
   bool enabled_ = false;
   std::map<std::string, Caller> by_token_;
 };
