@@ -48,6 +48,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   store_ = std::make_unique<JobStore>(options_.db_file);
   device_options.max_queued = options_.device_queue_size;
   device_options.limits = options_.limits;
+  device_options.prune = {options_.keep_jobs, options_.keep_days};
   queue_ = std::make_unique<DeviceQueue>(*store_, link_.get(), device_options);
   pool_ = std::make_unique<WorkPool>(options_.worker_count(), options_.queue_size);
   planning_ = std::make_unique<PlanningServiceImpl>(auth_, maps_, options_.limits, *pool_, *cache_);
@@ -71,7 +72,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   }
   server_->GetHealthCheckService()->SetServingStatus(kPlanningService, true);
   server_->GetHealthCheckService()->SetServingStatus(kCalibrationService, true);
-  queue_->start([this](bool connected) { set_device_health(connected); });
+  queue_->start([this](bool serving) { set_device_health(serving); });
   log_event("server_started", {{"listen", options_.listen},
                                {"port", port_},
                                {"workers", pool_->workers()},
@@ -84,9 +85,9 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
 
 HapticServer::~HapticServer() { shutdown(); }
 
-void HapticServer::set_device_health(bool connected) {
+void HapticServer::set_device_health(bool serving) {
   std::lock_guard lock(health_mutex_);
-  if (serving_) server_->GetHealthCheckService()->SetServingStatus(kDeviceService, connected);
+  if (serving_) server_->GetHealthCheckService()->SetServingStatus(kDeviceService, serving);
 }
 
 void HapticServer::shutdown() {

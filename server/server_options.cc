@@ -9,7 +9,7 @@ const char* const kServerUsage =
     "usage: hapticjam-server --listen HOST:PORT [--device HOST:PORT|SERIAL] [--workers N]\n"
     "                        [--auth FILE] [--db FILE] [--tls-cert F --tls-key F]\n"
     "                        [--map NAME=FILE ...] [--queue-size N] [--device-queue-size N]\n"
-    "                        [--cache-size N] [--max-message-mib N]\n"
+    "                        [--cache-size N] [--max-message-mib N] [--keep-jobs N] [--keep-days N]\n"
     "The hapticjam gRPC server (proto/hapticjam/v1): planning on a pool of simulator\n"
     "workers, and a persistent queue of jobs for the attached array.\n"
     "  --listen HOST:PORT      address to serve on; port 0 picks a free port (printed).\n"
@@ -29,6 +29,10 @@ const char* const kServerUsage =
     "  --device-queue-size N   device jobs that may wait (default 64)\n"
     "  --cache-size N          planning results kept for repeated requests (default 256, 0 = off)\n"
     "  --max-message-mib N     largest request accepted (default 64 MiB)\n"
+    "  --keep-jobs N           finished device jobs (with their captures) kept, newest first\n"
+    "                          (default 1000, 0 = no bound)\n"
+    "  --keep-days N           finished device jobs older than N days are deleted (default 30,\n"
+    "                          0 = no bound)\n"
     "  --help                  this text\n"
     "Logs: one JSON object per line on stderr. SIGINT/SIGTERM shut down cleanly.\n";
 
@@ -84,6 +88,8 @@ ServerOptions parse_server_args(const std::vector<std::string>& args, bool* help
     else if (a == "--device-queue-size") out.device_queue_size = parse_count(a, v, 1, 1'000'000);
     else if (a == "--cache-size") out.cache_size = parse_count(a, v, 0, 1'000'000);
     else if (a == "--max-message-mib") out.limits.max_message_bytes = parse_count(a, v, 1, 1024) << 20;
+    else if (a == "--keep-jobs") out.keep_jobs = parse_count(a, v, 0, 100'000'000);
+    else if (a == "--keep-days") out.keep_days = parse_count(a, v, 0, 100'000);
     else throw std::invalid_argument("unknown option " + a + " (see --help)");
   }
   out.validate();

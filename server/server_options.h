@@ -22,6 +22,8 @@ struct ServerOptions {
   int queue_size = 16;                // planning requests that may wait for a worker
   int device_queue_size = 64;         // device jobs that may wait
   int cache_size = 256;               // planning results kept
+  int keep_jobs = 1000;               // finished device jobs kept (newest); 0 = no bound
+  int keep_days = 30;                 // finished device jobs kept no longer; 0 = no bound
   ServerLimits limits;
 
   // Throws std::invalid_argument naming the flag: no --listen, a non-loopback

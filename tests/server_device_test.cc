@@ -167,7 +167,7 @@ TEST(ServerDevice, EmergencyStopVentsAtOnceAndPauses) {
   v1::EmergencyStopRequest request;
   request.set_reason("hand on the surface");
   v1::DeviceStatus status;
-  EXPECT_EQ(s.device->EmergencyStop(call("alice-token-1").get(), request, &status).error_code(),
+  EXPECT_EQ(s.device->EmergencyStop(call("carol-token-3").get(), request, &status).error_code(),
             StatusCode::PERMISSION_DENIED);
   ASSERT_TRUE(s.device->EmergencyStop(call("root-token-444").get(), request, &status).ok());
   // Vented while the job's step was still held: the stop did not wait for the queue.
@@ -183,6 +183,30 @@ TEST(ServerDevice, EmergencyStopVentsAtOnceAndPauses) {
   submit(s, "alice-token-1", device_plan({"p 0.1"}), &refused);
   EXPECT_EQ(refused.error_code(), StatusCode::FAILED_PRECONDITION);
   s.link->free_run();
+}
+
+// A role that cannot stop the array cannot clear a stop: operators do both, previewers neither.
+TEST(ServerDevice, WhoMayStopMayResumeAndNoOneElse) {
+  ScratchDir dir;
+  AuthServer auth(dir.path);
+  TestServer s(auth.options);
+  ASSERT_TRUE(eventually([&] { return queue(s).device_connected(); }));
+  v1::EmergencyStopRequest request;
+  v1::DeviceStatus status;
+  v1::QueueState resumed;
+  EXPECT_EQ(s.device->EmergencyStop(call("carol-token-3").get(), request, &status).error_code(),
+            StatusCode::PERMISSION_DENIED);
+  ASSERT_TRUE(s.device->EmergencyStop(call("bob-token-22").get(), request, &status).ok());
+  EXPECT_TRUE(status.emergency_stopped());
+  const grpc::Status denied = s.device->ResumeQueue(call("carol-token-3").get(), {}, &resumed);
+  EXPECT_EQ(denied.error_code(), StatusCode::PERMISSION_DENIED);
+  EXPECT_NE(denied.error_message().find("operator"), std::string::npos) << denied.error_message();
+  EXPECT_TRUE(queue(s).paused());
+  ASSERT_TRUE(s.device->ResumeQueue(call("bob-token-22").get(), {}, &resumed).ok());
+  EXPECT_FALSE(resumed.paused());
+  // The halt is cleared with the stop: a job runs again.
+  const v1::Job job = submit(s, "alice-token-1", device_plan({"p 0.2"}));
+  ASSERT_TRUE(eventually([&] { return job_state_is(s, job.id(), v1::JOB_STATE_DONE); }));
 }
 
 TEST(ServerDevice, ARestartOnTheSameDatabaseKeepsTheQueueAndReportsTheRunningJobInterrupted) {
