@@ -46,7 +46,8 @@ for target in "${targets[@]}"; do
   log="$build/fuzz-$target.log"
   "$build/tests/fuzz/$target" -max_total_time="$seconds" -print_final_stats=1 -rss_limit_mb=2048 \
     -artifact_prefix="$crashes/" -fork=1 -ignore_crashes=1 "$corpus" >"$log" 2>&1 || true
-  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | awk '{s+=$1} END {print s+0}')
+  # -fork prints a running total "#N: cov: ..."; the last one is the count.
+  execs=$( (grep -oE '^#[0-9]+' "$log" || true) | tail -1 | tr -d '#')
   found=$(find "$crashes" -type f | wc -l)
   printf '%-18s %12s %8s\n' "$target" "$execs" "$found"
 done

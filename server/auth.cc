@@ -67,6 +67,12 @@ Authenticator Authenticator::from_file(const std::filesystem::path& file) {
       throw std::invalid_argument(where + ": token of \"" + name + "\" already belongs to another caller");
   }
   if (auth.by_token_.empty()) throw std::invalid_argument("auth file \"" + file.string() + "\" names no caller");
+  using std::filesystem::perms;
+  std::error_code error;
+  const perms mode = std::filesystem::status(file, error).permissions();
+  if (!error && (mode & (perms::group_read | perms::others_read)) != perms::none)
+    auth.warnings_.push_back("auth file \"" + file.string() +
+                             "\" is readable by other users (its tokens are secrets): chmod 600 it");
   return auth;
 }
 

@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace hj::server {
 
@@ -33,6 +34,8 @@ class Authenticator {
   static Authenticator from_file(const std::filesystem::path& file);
 
   bool enabled() const { return enabled_; }
+  // What the server should warn about (e.g. a token file others can read).
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
   // The caller for an `authorization` header value (empty if none was sent),
   // needing at least `role`.
@@ -45,6 +48,7 @@ class Authenticator {
 
   bool enabled_ = false;
   std::map<std::string, Caller> by_token_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace hj::server

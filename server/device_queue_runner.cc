@@ -184,6 +184,7 @@ void DeviceQueue::run_job(std::unique_lock<std::mutex>& lock, std::int64_t id) {
   std::string error;
   bool fault = false;   // the link failed: interrupt and pause
   bool halted = false;  // an emergency stop refused the step (record_stop ends the job)
+  bool vented = false;  // the device dropped the step: it vented (a stop's vent, or its watchdog)
   lock.unlock();
   try {
     // Every plan starts from the rest state.
@@ -214,7 +215,8 @@ void DeviceQueue::run_job(std::unique_lock<std::mutex>& lock, std::int64_t id) {
   } catch (const device::DeviceError& e) {
     error = e.what();
     // Not sent (halted), or dropped by a device that vented: most likely a stop in flight.
-    halted = e.kind() == device::DeviceError::Kind::kHalted || e.kind() == device::DeviceError::Kind::kVented;
+    vented = e.kind() == device::DeviceError::Kind::kVented;
+    halted = vented || e.kind() == device::DeviceError::Kind::kHalted;
     fault = e.kind() != device::DeviceError::Kind::kRefused;
   } catch (const std::exception& e) {
     error = e.what();
@@ -223,9 +225,10 @@ void DeviceQueue::run_job(std::unique_lock<std::mutex>& lock, std::int64_t id) {
   if (stopping_ && !running_aborted_) {
     // Left `running`: the next start reports it interrupted.
   } else if (halted) {
-    // The stop ends the job itself, with its reason, once its vent is answered.
-    wake_.wait_for(lock, options_.vent_timeout + std::chrono::seconds(1),
-                   [&] { return emergency_stopped_ || stopping_ || store_failed_; });
+    // The stop ends the job itself, with its reason, once its vent is
+    // answered: at once when the device already vented, else within the vent's timeout.
+    const auto bound = vented ? std::chrono::milliseconds(2000) : options_.vent_timeout + std::chrono::seconds(1);
+    wake_.wait_for(lock, bound, [&] { return emergency_stopped_ || stopping_ || store_failed_; });
     need_vent_ = true;
     // No stop came (the device's watchdog vented): a fault.
     if (!running_aborted_)

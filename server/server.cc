@@ -40,6 +40,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
     : options_(std::move(options)), link_(std::move(link)) {
   options_.validate();
   if (!options_.auth_file.empty()) auth_ = Authenticator::from_file(options_.auth_file);
+  for (const std::string& warning : auth_.warnings()) log_event("warning", {{"message", warning}});
   for (const auto& [name, file] : options_.maps) {
     maps_.add(name, file, options_.limits);
     log_event("map_loaded", {{"name", name}, {"file", file}});

@@ -7,7 +7,7 @@ namespace hj::server {
 
 const char* const kServerUsage =
     "usage: hapticjam-server --listen HOST:PORT [--device HOST:PORT|SERIAL] [--workers N]\n"
-    "                        [--auth FILE] [--db FILE] [--tls-cert F --tls-key F]\n"
+    "                        [--auth FILE] [--db FILE] [--tls-cert F --tls-key F] [--trusted-network]\n"
     "                        [--map NAME=FILE ...] [--queue-size N] [--device-queue-size N]\n"
     "                        [--cache-size N] [--max-message-mib N] [--keep-jobs N] [--keep-days N]\n"
     "The hapticjam gRPC server (proto/hapticjam/v1): planning on a pool of simulator\n"
@@ -22,6 +22,8 @@ const char* const kServerUsage =
     "                          ROLE preview | operator | admin (server/README.md)\n"
     "  --db FILE               the device queue's SQLite database (default hapticjam-queue.db)\n"
     "  --tls-cert F --tls-key F  serve TLS with this PEM certificate chain and key\n"
+    "  --trusted-network       allow --auth on a non-loopback address without TLS (the\n"
+    "                          tokens then cross the network in the clear)\n"
     "  --map NAME=FILE         a goal map (DEM table, image) clients can name and crop;\n"
     "                          repeatable\n"
     "  --queue-size N          planning requests that may wait for a worker (default 16);\n"
@@ -70,6 +72,10 @@ ServerOptions parse_server_args(const std::vector<std::string>& args, bool* help
       return out;
     }
     if (a.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument \"" + a + "\"");
+    if (a == "--trusted-network") {
+      out.trusted_network = true;
+      continue;
+    }
     if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
     const std::string& v = args[++i];
     if (a == "--listen") out.listen = v;
@@ -103,6 +109,10 @@ void ServerOptions::validate() const {
     throw std::invalid_argument("--listen " + listen +
                                 " is not a loopback address: without --auth the server lets every caller do "
                                 "everything, so it listens only on 127.0.0.1, localhost or [::1]; give --auth FILE");
+  if (!auth_file.empty() && !is_loopback_listen(listen) && tls_cert.empty() && !trusted_network)
+    throw std::invalid_argument("--listen " + listen + " with --auth but without TLS would send the bearer tokens "
+                                "in the clear; give --tls-cert and --tls-key, or --trusted-network if the network "
+                                "is private");
   if (tls_cert.empty() != tls_key.empty()) throw std::invalid_argument("--tls-cert and --tls-key go together");
   if (workers < 0) throw std::invalid_argument("--workers must be at least 1");
   if (db_file.empty()) throw std::invalid_argument("--db needs a file name");

@@ -18,6 +18,7 @@ struct ServerOptions {
   std::string auth_file;              // "" = no auth, loopback only
   std::string db_file = "hapticjam-queue.db";
   std::string tls_cert, tls_key;      // PEM files; both or neither
+  bool trusted_network = false;       // --auth without TLS off loopback is allowed
   std::vector<std::pair<std::string, std::string>> maps;  // NAME, FILE
   int queue_size = 16;                // planning requests that may wait for a worker
   int device_queue_size = 64;         // device jobs that may wait
@@ -27,7 +28,8 @@ struct ServerOptions {
   ServerLimits limits;
 
   // Throws std::invalid_argument naming the flag: no --listen, a non-loopback
-  // --listen without --auth, half of the TLS pair, a count out of range.
+  // --listen without --auth, or with --auth but neither TLS nor
+  // --trusted-network, half of the TLS pair, a count out of range.
   void validate() const;
   int worker_count() const;  // workers, or the core count
 };

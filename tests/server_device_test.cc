@@ -6,6 +6,7 @@
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/impl/codegen/client_unary_call.h>
 
+#include "expect_error.h"
 #include "server_fixture.h"
 
 namespace hj {
@@ -334,7 +335,13 @@ TEST(ServerDevice, HealthFollowsTheDeviceLink) {
 TEST(ServerOptions, WithoutAuthOnlyLoopbackIsAllowed) {
   bool help = false;
   EXPECT_THROW(server::parse_server_args({"--listen", "0.0.0.0:7000"}, &help), std::invalid_argument);
-  EXPECT_NO_THROW(server::parse_server_args({"--listen", "0.0.0.0:7000", "--auth", "a.txt"}, &help));
+  // Tokens never cross a network in the clear unless the operator says it is private.
+  testing_support::expect_error<std::invalid_argument>(
+      [&] { server::parse_server_args({"--listen", "0.0.0.0:7000", "--auth", "a.txt"}, &help); },
+      {"--listen 0.0.0.0:7000", "in the clear", "--trusted-network"});
+  EXPECT_NO_THROW(server::parse_server_args({"--listen", "0.0.0.0:7000", "--auth", "a.txt", "--trusted-network"}, &help));
+  EXPECT_NO_THROW(server::parse_server_args(
+      {"--listen", "0.0.0.0:7000", "--auth", "a.txt", "--tls-cert", "c.pem", "--tls-key", "k.pem"}, &help));
   EXPECT_NO_THROW(server::parse_server_args({"--listen", "[::1]:7000"}, &help));
   EXPECT_THROW(server::parse_server_args({"--listen", "127.0.0.1:1", "--tls-cert", "c.pem"}, &help),
                std::invalid_argument);
@@ -353,6 +360,18 @@ TEST(ServerOptions, AuthFileErrorsNameTheLine) {
     EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("superuser"), std::string::npos) << e.what();
   }
+}
+
+TEST(ServerOptions, ATokenFileOthersCanReadIsWarnedAbout) {
+  ScratchDir dir;
+  const auto file = dir.path / "auth.txt";
+  std::ofstream(file) << "alice operator alice-token-1\n";
+  std::filesystem::permissions(file, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  EXPECT_TRUE(server::Authenticator::from_file(file).warnings().empty());
+  std::filesystem::permissions(file, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+  const auto warnings = server::Authenticator::from_file(file).warnings();
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("readable by other users"), std::string::npos) << warnings[0];
 }
 
 }  // namespace

@@ -20,9 +20,8 @@ using json = nlohmann::json;
 
 constexpr std::string_view kFormat = "hapticjam.session/1";
 constexpr long long kMaxGridSamples = 25'000'000;
-// Checked before any state is built from them: the array's cells per side
-// (the mesh is built from it) and the steps of one session.
-constexpr int kMaxDeviceSideCells = 64;
+// Steps of one session, checked before any is read (the array's size is
+// bounded by the mesh's own point limit).
 constexpr std::size_t kMaxSessionSteps = 100'000;
 
 // Where a message points: the file, and the step being read (if any).
@@ -98,9 +97,6 @@ SessionDevice read_device(const json& root, const Context& ctx) {
   SessionDevice device;
   device.rows = positive_int(d, "rows", ctx, "device.rows");
   device.cols = positive_int(d, "cols", ctx, "device.cols");
-  for (const auto& [key, cells] : {std::pair{"device.rows", device.rows}, std::pair{"device.cols", device.cols}})
-    if (cells > kMaxDeviceSideCells)
-      fail(ctx, key, std::to_string(cells) + " cells is over the limit of " + std::to_string(kMaxDeviceSideCells));
   device.cell_size_mm = positive_number(require(d, "cell_size_mm", ctx, "device.cell_size_mm"), ctx,
                                         "device.cell_size_mm", "mm");
   const json& max_kpa = require(d, "max_pressure_kpa", ctx, "device.max_pressure_kpa");

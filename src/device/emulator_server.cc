@@ -31,6 +31,7 @@ struct Connection {
   std::array<char, 4096> buffer{};
   std::deque<std::string> out;
   bool closed = false;
+  bool actuated = false;  // it sent an action since the last vent (io thread)
 };
 
 // A device command for the worker. Without a connection it is the
@@ -151,6 +152,7 @@ struct EmulatorServer::Impl {
     auto command = std::make_shared<DeviceCommand>();
     command->connection = c;
     command->request = r;
+    if (r.command == Command::kAction) c->actuated = true;
     std::lock_guard lock(mutex);
     if (r.command == Command::kAction) record_action(line);
     jobs.push_back(std::move(command));
@@ -168,6 +170,7 @@ struct EmulatorServer::Impl {
   // now; commands not yet begun, and one in progress, are answered
   // "cancelled"; the membrane relaxes on the worker before anything else.
   void vent_at_once(const std::string& why) {
+    for (const auto& c : connections) c->actuated = false;
     std::deque<std::shared_ptr<DeviceCommand>> overtaken;
     {
       std::lock_guard lock(mutex);
@@ -219,7 +222,9 @@ struct EmulatorServer::Impl {
     });
   }
 
-  // A closed connection counts as silence: an actuated array vents at once.
+  // A closed connection counts as silence: if it actuated the array since
+  // the last vent, the array vents at once (and nothing it queued is
+  // carried out). Another connection closing (a tool's) changes nothing.
   void close(const std::shared_ptr<Connection>& c) {
     if (c->closed) return;
     c->closed = true;
@@ -227,12 +232,7 @@ struct EmulatorServer::Impl {
     c->socket.shutdown(tcp::socket::shutdown_both, ignored);
     c->socket.close(ignored);
     connections.erase(c);
-    bool armed = false;
-    {
-      std::lock_guard lock(mutex);
-      armed = actuated || !jobs.empty() || current;
-    }
-    if (armed) vent_at_once("connection closed");
+    if (c->actuated) vent_at_once("connection closed");
   }
 
   void stall(std::chrono::milliseconds duration) {
