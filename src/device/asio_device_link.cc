@@ -89,6 +89,9 @@ struct AsioDeviceLink::Impl {
   bool up = false;
   bool stopping = false;
   bool halted = false;  // actions are refused unsent (halt_and_vent)
+  // Vents mirrored so far: an action acknowledged before a vent but mirrored
+  // after it (its caller's thread ran late) must not undo the vent's mirror.
+  std::uint64_t vents_mirrored = 0;
   DeviceStatus status;
   std::function<void(bool)> callback;
   // Bumped (under `mutex`) on every connection attempt and every drop, so
@@ -442,10 +445,15 @@ void AsioDeviceLink::execute(const Action& action, std::chrono::milliseconds tim
   r.action = action;
   std::string command = protocol::format_request(r);
   command = command.substr(command.find(' ') + 1);  // without the placeholder id
+  std::uint64_t vents_before = 0;
+  {
+    std::lock_guard lock(impl_->mutex);
+    vents_before = impl_->vents_mirrored;
+  }
   impl_->request(command, timeout, /*actuates=*/true);
-  // Acknowledged: mirror it.
+  // Acknowledged: mirror it, unless a vent has been mirrored since.
   std::lock_guard lock(impl_->mutex);
-  mirror_action(impl_->status, action);
+  if (impl_->vents_mirrored == vents_before) mirror_action(impl_->status, action);
 }
 
 Capture AsioDeviceLink::capture(std::chrono::milliseconds timeout) {
@@ -464,6 +472,7 @@ Capture AsioDeviceLink::capture(std::chrono::milliseconds timeout) {
 void AsioDeviceLink::vent(std::chrono::milliseconds timeout) {
   impl_->request("vent", timeout);
   std::lock_guard lock(impl_->mutex);
+  ++impl_->vents_mirrored;
   mirror_vent(impl_->status);
 }
 
