@@ -1,5 +1,6 @@
 #include "auth.h"
 
+#include <cstdint>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -27,7 +28,23 @@ Role parse_role(const std::string& text, const std::string& where) {
   throw std::invalid_argument(where + ": unknown role \"" + text + "\" (preview, operator or admin)");
 }
 
+// Equal in time that depends on the lengths only, not on where the first
+// difference is (a timing side channel would reveal a token byte by byte).
+bool same_secret(const std::string& a, const std::string& b) {
+  unsigned char difference = a.size() == b.size() ? 0 : 1;
+  for (std::size_t i = 0; i < a.size(); ++i) difference |= std::uint8_t(a[i] ^ (i < b.size() ? b[i] : 0));
+  return difference == 0;
+}
+
 }  // namespace
+
+// Every token is compared, whether or not one matched already.
+const Caller* Authenticator::match_token(const std::string& token) const {
+  const Caller* found = nullptr;
+  for (const auto& [known, caller] : by_token_)
+    if (same_secret(token, known)) found = &caller;
+  return found;
+}
 
 Authenticator Authenticator::from_file(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -50,6 +67,12 @@ Authenticator Authenticator::from_file(const std::filesystem::path& file) {
       throw std::invalid_argument(where + ": token of \"" + name + "\" already belongs to another caller");
   }
   if (auth.by_token_.empty()) throw std::invalid_argument("auth file \"" + file.string() + "\" names no caller");
+  using std::filesystem::perms;
+  std::error_code error;
+  const perms mode = std::filesystem::status(file, error).permissions();
+  if (!error && (mode & (perms::group_read | perms::others_read)) != perms::none)
+    auth.warnings_.push_back("auth file \"" + file.string() +
+                             "\" is readable by other users (its tokens are secrets): chmod 600 it");
   return auth;
 }
 
@@ -60,9 +83,9 @@ Caller Authenticator::authorize(const std::optional<std::string>& authorization,
   if (!authorization || authorization->rfind(prefix, 0) != 0)
     throw ServiceError(grpc::StatusCode::UNAUTHENTICATED,
                        "no bearer token: send metadata \"authorization: Bearer TOKEN\"");
-  const auto found = by_token_.find(authorization->substr(prefix.size()));
-  if (found == by_token_.end()) throw ServiceError(grpc::StatusCode::UNAUTHENTICATED, "unknown bearer token");
-  const Caller& caller = found->second;
+  const Caller* found = match_token(authorization->substr(prefix.size()));
+  if (found == nullptr) throw ServiceError(grpc::StatusCode::UNAUTHENTICATED, "unknown bearer token");
+  const Caller& caller = *found;
   if (caller.role < role)
     throw ServiceError(grpc::StatusCode::PERMISSION_DENIED,
                        "caller \"" + caller.name + "\" has role " + role_name(caller.role) + "; " + action +

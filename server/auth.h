@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace hj::server {
 
@@ -33,6 +34,8 @@ class Authenticator {
   static Authenticator from_file(const std::filesystem::path& file);
 
   bool enabled() const { return enabled_; }
+  // What the server should warn about (e.g. a token file others can read).
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
   // The caller for an `authorization` header value (empty if none was sent),
   // needing at least `role`.
@@ -41,8 +44,11 @@ class Authenticator {
   Caller authorize(const std::optional<std::string>& authorization, Role role, const std::string& action) const;
 
  private:
+  const Caller* match_token(const std::string& token) const;
+
   bool enabled_ = false;
   std::map<std::string, Caller> by_token_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace hj::server

@@ -11,14 +11,30 @@ namespace hj::server {
 namespace v1 = ::hapticjam::v1;
 using grpc::StatusCode;
 
+namespace {
+
+// A shutdown does not wait longer than this for the device's vent.
+constexpr std::chrono::milliseconds kShutdownVentTimeout{2000};
+// Checking a step needs the cells and nodes only: the coarsest mesh.
+constexpr int kValidationSegments = 2;
+
+// A job's place in the queue: the running job is 0, the next one 1
+// (`active` lists the running job first).
+int queue_position(const std::vector<StoredJob>& active, std::size_t index) {
+  return int(index) + (active.front().state == v1::JOB_STATE_RUNNING ? 0 : 1);
+}
+
+}  // namespace
+
 DeviceQueue::DeviceQueue(JobStore& store, device::DeviceLink* link, DeviceQueueOptions options)
     : store_(store), link_(link), options_(std::move(options)) {}
 
 DeviceQueue::~DeviceQueue() { stop(); }
 
-void DeviceQueue::start(std::function<void(bool)> on_connection) {
-  on_connection_ = std::move(on_connection);
-  if (on_connection_) on_connection_(false);
+void DeviceQueue::start(std::function<void(bool)> on_serving) {
+  on_serving_ = std::move(on_serving);
+  if (on_serving_) on_serving_(false);
+  store_.prune(options_.prune);
   if (link_) {
     link_->on_connection_change([this](bool connected) { connection_changed(connected); });
     link_->start();
@@ -33,7 +49,17 @@ void DeviceQueue::stop() {
     stopping_ = true;
     changed();
   }
-  // The link first: a command in flight fails at once instead of holding the runner.
+  // The safe state before the link closes; the halt keeps the runner's next
+  // step unsent. (A crash or kill is covered by the device's own watchdog.)
+  if (link_ && link_->connected()) {
+    try {
+      link_->halt_and_vent(std::min(options_.vent_timeout, kShutdownVentTimeout));
+      log_event("device_vented", {{"by", "shutdown"}});
+    } catch (const device::DeviceError& e) {
+      log_event("device_vent_failed", {{"error", e.what()}, {"by", "shutdown"}});
+    }
+  }
+  // Then the link: a command in flight fails at once instead of holding the runner.
   if (link_) link_->stop();
   if (runner_.joinable()) runner_.join();
 }
@@ -54,145 +80,6 @@ std::uint64_t DeviceQueue::wait_for_change(std::uint64_t seen, std::chrono::mill
   return version_;
 }
 
-void DeviceQueue::pause(const std::string& reason) {
-  store_.set_paused(true, reason);
-  log_event("queue_paused", {{"reason", reason}});
-}
-
-void DeviceQueue::abort_running(v1::JobState state, const std::string& why) {
-  if (running_id_ == 0 || running_aborted_) return;
-  store_.set_state(running_id_, state, why);
-  running_aborted_ = true;
-  log_event("job_ended", {{"job", running_id_}, {"state", v1::JobState_Name(state)}, {"error", why}});
-}
-
-void DeviceQueue::connection_changed(bool connected) {
-  {
-    std::lock_guard lock(mutex_);
-    connected_ = connected;
-    if (connected) {
-      need_vent_ = true;  // first thing on every (re)connection: the safe state
-    } else {
-      need_vent_ = true;
-      if (running_id_ != 0 && !running_aborted_) {
-        const std::string why = "the device link dropped during the job";
-        abort_running(v1::JOB_STATE_INTERRUPTED, why);
-        pause("job " + std::to_string(running_id_) + " was interrupted: " + why +
-              "; the device is vented on reconnect and an operator must resume the queue (ResumeQueue)");
-      }
-    }
-    log_event("device_link", {{"connected", connected}});
-    changed();
-  }
-  if (on_connection_) on_connection_(connected);
-}
-
-// The runner: vents when needed, then runs the oldest queued job whenever
-// the device is connected and the queue is not paused.
-void DeviceQueue::run() {
-  std::unique_lock lock(mutex_);
-  while (!stopping_) {
-    if (connected_ && need_vent_) {
-      const std::uint64_t seen = version_;
-      // Failed: retry after a pause, or at once when the link comes back.
-      if (!vent_now(lock))
-        wake_.wait_for(lock, std::chrono::milliseconds(500), [&] { return stopping_ || version_ > seen + 1; });
-      continue;
-    }
-    const bool can_run = connected_ && !store_.paused() && !emergency_stopped_;
-    const auto queued = can_run ? store_.active() : std::vector<StoredJob>{};
-    if (queued.empty()) {
-      const std::uint64_t seen = version_;
-      wake_.wait_for(lock, std::chrono::milliseconds(500), [&] { return stopping_ || version_ != seen; });
-      continue;
-    }
-    run_job(lock, queued.front().id);
-  }
-}
-
-bool DeviceQueue::vent_now(std::unique_lock<std::mutex>& lock) {
-  lock.unlock();
-  std::string error;
-  try {
-    link_->vent(options_.vent_timeout);
-  } catch (const device::DeviceError& e) {
-    error = e.what();
-  }
-  lock.lock();
-  if (error.empty()) {
-    need_vent_ = false;
-    log_event("device_vented");
-  } else {
-    last_error_ = "vent failed: " + error;
-    log_event("device_vent_failed", {{"error", error}});
-  }
-  changed();
-  return error.empty();
-}
-
-void DeviceQueue::run_job(std::unique_lock<std::mutex>& lock, std::int64_t id) {
-  const v1::Plan plan = store_.plan(id);
-  store_.set_state(id, v1::JOB_STATE_RUNNING);
-  running_id_ = id;
-  running_aborted_ = false;
-  log_event("job_started", {{"job", id}, {"steps", plan.steps_size()}});
-  changed();
-
-  std::string error;
-  bool fault = false;  // the link failed: interrupt and pause
-  lock.unlock();
-  try {
-    // Every plan starts from the rest state.
-    link_->vent(options_.vent_timeout);
-    for (int i = 0; i < plan.steps_size(); ++i) {
-      {
-        std::lock_guard check(mutex_);
-        if (running_aborted_ || stopping_) break;
-      }
-      const DeviceStep step = step_from_proto(plan.steps(i), "step " + std::to_string(i));
-      if (step.capture) {
-        const device::Capture capture = link_->capture(options_.capture_timeout);
-        v1::CaptureFrame frame;
-        capture_to_proto(capture, &frame);
-        frame.set_step_index(i);
-        frame.set_label(step.label);
-        std::lock_guard store(mutex_);
-        store_.add_capture(id, frame);
-      } else {
-        link_->execute(step.action, options_.step_timeout);
-      }
-      std::lock_guard progress(mutex_);
-      if (!running_aborted_) store_.set_progress(id, i + 1);
-      changed();
-    }
-  } catch (const device::DeviceError& e) {
-    error = e.what();
-    fault = e.kind() != device::DeviceError::Kind::kRefused;
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
-  lock.lock();
-  if (stopping_ && !running_aborted_) {
-    // Left `running`: the next start reports it interrupted.
-  } else if (!error.empty()) {
-    last_error_ = error;
-    need_vent_ = true;
-    if (fault) {
-      abort_running(v1::JOB_STATE_INTERRUPTED, "device: " + error);
-      if (!store_.paused()) pause("job " + std::to_string(id) + " was interrupted: " + error + "; an operator must resume the queue (ResumeQueue)");
-    } else {
-      abort_running(v1::JOB_STATE_FAILED, "device refused: " + error);
-    }
-  } else if (running_aborted_) {
-    need_vent_ = true;  // cancelled or stopped part way: back to the safe state
-  } else {
-    abort_running(v1::JOB_STATE_DONE, "");
-  }
-  running_id_ = 0;
-  running_aborted_ = false;
-  changed();
-}
-
 void DeviceQueue::require_device(const char* action) {
   if (!link_)
     throw ServiceError(StatusCode::FAILED_PRECONDITION,
@@ -208,14 +95,15 @@ v1::Job DeviceQueue::submit(const Caller& caller, const std::string& name, const
                                                          std::to_string(options_.limits.max_job_steps));
   std::lock_guard lock(mutex_);
   require_device("submit a job");
+  require_store("submit a job");
   if (emergency_stopped_ || store_.paused())
     throw ServiceError(StatusCode::FAILED_PRECONDITION, "queue paused: " + store_.pause_reason());
 
   // Every step against the device's own limits, before anything is queued.
   const device::DeviceStatus status = link_->status();
-  if (status.rows < 1 || status.cols < 1)
-    throw ServiceError(StatusCode::FAILED_PRECONDITION, "device reported no array size");
-  const Mesh mesh(ArrayGeometry{status.rows, status.cols, 0.038, 2});
+  if (status.rows < 1 || status.cols < 1 || !(status.cell_mm > 0.0))
+    throw ServiceError(StatusCode::FAILED_PRECONDITION, "device reported no array size or cell size");
+  const Mesh mesh(ArrayGeometry{status.rows, status.cols, status.cell_mm / 1000.0, kValidationSegments});
   SurfaceParameters limits;
   if (status.max_pressure_pa > 0.0) limits.max_pressure_pa = status.max_pressure_pa;
   for (int i = 0; i < plan.steps_size(); ++i) {
@@ -238,12 +126,13 @@ v1::Job DeviceQueue::submit(const Caller& caller, const std::string& name, const
   changed();
   const auto jobs = store_.active();
   for (size_t i = 0; i < jobs.size(); ++i)
-    if (jobs[i].id == id) return to_proto(jobs[i], int(i) + (jobs.front().state == v1::JOB_STATE_RUNNING ? 0 : 1));
+    if (jobs[i].id == id) return to_proto(jobs[i], queue_position(jobs, i));
   return to_proto(*store_.find(id), -1);
 }
 
 v1::Job DeviceQueue::cancel(const Caller& caller, std::int64_t id) {
   std::lock_guard lock(mutex_);
+  require_store("cancel a job");
   const auto job = store_.find(id);
   if (!job) throw ServiceError(StatusCode::NOT_FOUND, "no job " + std::to_string(id));
   if (job->owner != caller.name && caller.role < Role::kAdmin)
@@ -267,7 +156,7 @@ v1::Job DeviceQueue::get(std::int64_t id) {
   int position = -1;
   const auto jobs = store_.active();
   for (size_t i = 0; i < jobs.size(); ++i)
-    if (jobs[i].id == id) position = int(i) + (jobs.front().state == v1::JOB_STATE_RUNNING ? 0 : 1);
+    if (jobs[i].id == id) position = queue_position(jobs, i);
   v1::Job out = to_proto(*job, position);
   for (auto& frame : store_.captures(id)) *out.add_captures() = std::move(frame);
   return out;
@@ -292,8 +181,7 @@ v1::QueueState DeviceQueue::queue_state(int recent_finished) {
   std::lock_guard lock(mutex_);
   v1::QueueState out;
   const auto jobs = store_.active();
-  const int first = !jobs.empty() && jobs.front().state == v1::JOB_STATE_RUNNING ? 0 : 1;
-  for (size_t i = 0; i < jobs.size(); ++i) *out.add_jobs() = to_proto(jobs[i], int(i) + first);
+  for (size_t i = 0; i < jobs.size(); ++i) *out.add_jobs() = to_proto(jobs[i], queue_position(jobs, i));
   if (recent_finished > 0)
     for (const auto& job : store_.recent_finished(recent_finished)) *out.add_jobs() = to_proto(job, -1);
   out.set_paused(store_.paused() || emergency_stopped_);
@@ -336,40 +224,72 @@ v1::DeviceStatus DeviceQueue::device_status() {
 }
 
 v1::DeviceStatus DeviceQueue::emergency_stop(const Caller& caller, const std::string& reason) {
-  {
-    std::lock_guard lock(mutex_);
-    if (!link_) throw ServiceError(StatusCode::FAILED_PRECONDITION, "no device attached to stop");
-    const std::string why = "emergency stop by " + caller.name + (reason.empty() ? "" : ": " + reason);
-    emergency_stopped_ = true;
-    abort_running(v1::JOB_STATE_INTERRUPTED, why);
-    pause(why + "; an operator must resume the queue (ResumeQueue)");
-    changed();
-  }
-  // Straight to the link, not through the runner: it may be inside a step.
+  if (!link_) throw ServiceError(StatusCode::FAILED_PRECONDITION, "no device attached to stop");
+  const std::string why = "emergency stop by " + caller.name + (reason.empty() ? "" : ": " + reason);
+  // Vent first, under no lock of the queue's (a step or a store write in
+  // progress must not delay it); the link's halt keeps every later step unsent.
+  std::string vent_error;
   try {
-    link_->vent(options_.vent_timeout);
+    link_->halt_and_vent(options_.vent_timeout);
     log_event("device_vented", {{"by", caller.name}, {"emergency", true}});
   } catch (const device::DeviceError& e) {
-    std::lock_guard lock(mutex_);
-    need_vent_ = true;
-    last_error_ = std::string("emergency vent failed: ") + e.what();
-    throw ServiceError(StatusCode::FAILED_PRECONDITION,
-                       std::string("could not vent the device (") + e.what() +
-                           "); the queue is paused and the device is vented when it reconnects");
+    vent_error = e.what();
   }
+  record_stop(why, vent_error);
+  if (!vent_error.empty())
+    throw ServiceError(StatusCode::FAILED_PRECONDITION,
+                       "could not vent the device (" + vent_error +
+                           "); no step is sent, the queue is paused and the device is vented when it reconnects");
   return device_status();
+}
+
+void DeviceQueue::record_stop(const std::string& why, const std::string& vent_error) {
+  std::unique_lock lock(mutex_);
+  emergency_stopped_ = true;
+  if (!vent_error.empty()) {
+    need_vent_ = true;
+    last_error_ = "emergency vent failed: " + vent_error;
+  }
+  try {
+    interrupt_and_pause(why, why + "; an operator must resume the queue (ResumeQueue)");
+  } catch (const StoreError& e) {
+    // The array is vented and halted already; the record is what failed.
+    store_failed_ = true;
+    last_error_ = std::string("job database: ") + e.what();
+    log_event("job_database_failed", {{"error", e.what()}});
+    lock.unlock();
+    report_serving();
+    lock.lock();
+  }
+  changed();
 }
 
 v1::QueueState DeviceQueue::resume(const Caller& caller) {
   {
     std::lock_guard lock(mutex_);
     require_device("resume the queue");
+    try {
+      // A job the failed database could not end is not run again.
+      if (store_failed_) store_.interrupt_running("the job database failed while the job ran");
+      store_.set_paused(false);
+    } catch (const StoreError& e) {
+      throw ServiceError(StatusCode::UNAVAILABLE,
+                         std::string("the job database still fails, the queue stays paused: ") + e.what());
+    }
+    link_->release_halt();
     emergency_stopped_ = false;
-    store_.set_paused(false);
+    store_failed_ = false;
     log_event("queue_resumed", {{"by", caller.name}});
     changed();
   }
+  report_serving();
   return queue_state(0);
+}
+
+void DeviceQueue::require_store(const char* action) {
+  if (store_failed_)
+    throw ServiceError(StatusCode::UNAVAILABLE, std::string("cannot ") + action + ": " + last_error_ +
+                                                    "; an operator must resume the queue (ResumeQueue) once it is fixed");
 }
 
 }  // namespace hj::server

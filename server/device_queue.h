@@ -2,7 +2,9 @@
 // submission order, on the array behind a DeviceLink. A runner thread
 // executes jobs step by step; a link drop or an emergency stop interrupts the
 // running job and pauses the queue, the device is vented (its safe state)
-// before anything else runs, and only an admin's resume lets jobs run again.
+// before anything else runs, and only a resume lets jobs run again. Roles
+// (docs/safety.md): an operator or admin may stop and resume; a previewer
+// may do neither.
 #pragma once
 
 #include <chrono>
@@ -25,6 +27,7 @@ struct DeviceQueueOptions {
   std::chrono::milliseconds step_timeout{60'000};
   std::chrono::milliseconds capture_timeout{30'000};
   std::chrono::milliseconds vent_timeout{10'000};
+  PrunePolicy prune;  // finished jobs kept (--keep-jobs, --keep-days)
   ServerLimits limits;
 };
 
@@ -36,10 +39,13 @@ class DeviceQueue {
   DeviceQueue(const DeviceQueue&) = delete;
   DeviceQueue& operator=(const DeviceQueue&) = delete;
 
-  // `on_connection` is told every connection change (for health checking).
-  void start(std::function<void(bool connected)> on_connection = {});
-  // Stops the runner (a running job's current step finishes, the job is left
-  // `running` in the store and found `interrupted` by the next start) and the link.
+  // `on_serving` is told whether the device service can serve (connected,
+  // and no database failure waiting for an operator) on every change.
+  void start(std::function<void(bool serving)> on_serving = {});
+  // Vents the device (halting its link first, so no later step goes out),
+  // then stops the runner (a running job's current step finishes, the job is
+  // left `running` in the store and found `interrupted` by the next start)
+  // and the link.
   void stop();
 
   // Each throws ServiceError with the status code the API promises.
@@ -57,21 +63,34 @@ class DeviceQueue {
   bool stopping() const;
 
  private:
+  // The runner (device_queue_runner.cc).
   void run();
+  void run_once(std::unique_lock<std::mutex>& lock);
   void run_job(std::unique_lock<std::mutex>& lock, std::int64_t id);
   bool vent_now(std::unique_lock<std::mutex>& lock);
-  void changed();  // with mutex_ held
-  // Ends the running job as `state` (mutex_ held) if it is still running.
+  void store_failed(std::unique_lock<std::mutex>& lock, const std::string& what);
+  void connection_changed(bool connected);
+  void paused_by_drop();
+  void report_serving();  // without mutex_
+  // The stop's bookkeeping, after its vent (takes mutex_): stopped, the
+  // running job interrupted, paused.
+  void record_stop(const std::string& why, const std::string& vent_error);
+
+  // With mutex_ held.
+  void changed();
+  // Ends the running job as `state` if it is still running.
   void abort_running(hapticjam::v1::JobState state, const std::string& why);
+  // Ends the running job `interrupted` (if it runs) and pauses, in one transaction.
+  void interrupt_and_pause(const std::string& why, const std::string& reason);
   void pause(const std::string& reason);
   hapticjam::v1::Job to_proto(const StoredJob& job, int position) const;
-  void connection_changed(bool connected);
   void require_device(const char* action);
+  void require_store(const char* action);
 
   JobStore& store_;
   device::DeviceLink* link_;
   const DeviceQueueOptions options_;
-  std::function<void(bool)> on_connection_;
+  std::function<void(bool)> on_serving_;
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
@@ -80,6 +99,7 @@ class DeviceQueue {
   bool connected_ = false;
   bool need_vent_ = true;        // vent before the next job (start-up, reconnect, a cancel or failure)
   bool emergency_stopped_ = false;
+  bool store_failed_ = false;    // a database error paused the queue; cleared by resume
   std::int64_t running_id_ = 0;  // 0 = none
   bool running_aborted_ = false; // the running job was ended by cancel, drop or stop
   std::string last_error_;

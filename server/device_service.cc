@@ -65,7 +65,8 @@ grpc::Status DeviceServiceImpl::EmergencyStop(grpc::ServerContext* context, cons
                                               v1::DeviceStatus* response) {
   RequestContext rc(context, "EmergencyStop");
   return rc.finish([&] {
-    const Caller& caller = rc.authorize(auth_, Role::kAdmin, "EmergencyStop");
+    // Whoever may run jobs may stop the array, and clear their stop (ResumeQueue).
+    const Caller& caller = rc.authorize(auth_, Role::kOperator, "EmergencyStop");
     *response = queue_.emergency_stop(caller, request->reason());
   });
 }

@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <fstream>
 #include <stdexcept>
 
@@ -14,36 +13,46 @@ namespace hj::server {
 
 namespace {
 
-// A file holding `bytes` under a unique name with the extension of
-// `file_name` (the importer picks the format by it), removed on destruction.
+// A file holding `bytes` with the extension of `file_name` (the importer
+// picks the format by it), alone in a fresh private folder (0700) with its
+// sidecar, so an importer confined to the file's folder (a mesh naming other
+// files) reaches nothing but the upload; removed on destruction.
 class TemporaryGoalFile {
  public:
   TemporaryGoalFile(const std::string& bytes, const std::string& file_name, const std::string& sidecar) {
-    static std::atomic<long> counter{0};
-    const std::string extension = std::filesystem::path(file_name).extension().string();
-    path_ = std::filesystem::temp_directory_path() /
-            ("hj-goal-" + std::to_string(::getpid()) + "-" + std::to_string(++counter) + extension);
-    std::ofstream out(path_, std::ios::binary);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    if (!out) throw std::runtime_error("cannot write the goal to a temporary file " + path_.string());
-    if (!sidecar.empty()) {
+    std::string folder = (std::filesystem::temp_directory_path() / "hj-goal-XXXXXX").string();
+    if (::mkdtemp(folder.data()) == nullptr)
+      throw std::runtime_error("cannot make a temporary folder for the goal in " +
+                               std::filesystem::temp_directory_path().string());
+    folder_ = folder;
+    path_ = folder_ / ("goal" + std::filesystem::path(file_name).extension().string());
+    try {
+      write(path_, bytes, "the goal");
       // Beside it as NAME.json, where the importer looks for a sidecar.
-      sidecar_ = std::filesystem::path(path_).replace_extension(".json");
-      std::ofstream side(sidecar_, std::ios::binary);
-      side.write(sidecar.data(), std::streamsize(sidecar.size()));
-      if (!side) throw std::runtime_error("cannot write the goal's sidecar to " + sidecar_.string());
+      if (!sidecar.empty()) write(std::filesystem::path(path_).replace_extension(".json"), sidecar, "its sidecar");
+    } catch (...) {
+      std::error_code ignored;
+      std::filesystem::remove_all(folder_, ignored);
+      throw;
     }
   }
   ~TemporaryGoalFile() {
     std::error_code ignored;
-    std::filesystem::remove(path_, ignored);
-    if (!sidecar_.empty()) std::filesystem::remove(sidecar_, ignored);
+    std::filesystem::remove_all(folder_, ignored);
   }
+  TemporaryGoalFile(const TemporaryGoalFile&) = delete;
+  TemporaryGoalFile& operator=(const TemporaryGoalFile&) = delete;
   const std::filesystem::path& path() const { return path_; }
 
  private:
+  static void write(const std::filesystem::path& file, const std::string& bytes, const char* what) {
+    std::ofstream out(file, std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    if (!out) throw std::runtime_error(std::string("cannot write ") + what + " to the temporary file " + file.string());
+  }
+
+  std::filesystem::path folder_;
   std::filesystem::path path_;
-  std::filesystem::path sidecar_;
 };
 
 HeightMap import_bytes(const hapticjam::v1::GoalFile& file, const ImportOptions& options) {

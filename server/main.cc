@@ -15,10 +15,15 @@
 #include <vector>
 
 #include "device/make_device_link.h"
+#include "job_store.h"
 #include "json_log.h"
 #include "server.h"
 
 namespace {
+
+// Exit codes: 1 any other failure, 2 bad flags, 3 the job database cannot
+// be opened (corrupt, not a database, held by another server).
+constexpr int kExitStoreError = 3;
 
 // SIGINT / SIGTERM write their number into this pipe; a thread reads it and
 // shuts the server down (a handler may run on any thread, libraries start
@@ -126,6 +131,11 @@ int main(int argc, char** argv) {
     waiter.join();
     stop_web_viewer(web_viewer);
     return 0;
+  } catch (const StoreError& e) {
+    // Not worth a restart loop: the file needs a person (kExitStoreError).
+    std::fprintf(stderr, "hapticjam-server: %s (exit %d: the job database cannot be used; fix or move it)\n",
+                 e.what(), kExitStoreError);
+    return kExitStoreError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hapticjam-server: %s\n", e.what());
     return 1;

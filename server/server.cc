@@ -40,6 +40,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
     : options_(std::move(options)), link_(std::move(link)) {
   options_.validate();
   if (!options_.auth_file.empty()) auth_ = Authenticator::from_file(options_.auth_file);
+  for (const std::string& warning : auth_.warnings()) log_event("warning", {{"message", warning}});
   for (const auto& [name, file] : options_.maps) {
     maps_.add(name, file, options_.limits);
     log_event("map_loaded", {{"name", name}, {"file", file}});
@@ -48,6 +49,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   store_ = std::make_unique<JobStore>(options_.db_file);
   device_options.max_queued = options_.device_queue_size;
   device_options.limits = options_.limits;
+  device_options.prune = {options_.keep_jobs, options_.keep_days};
   queue_ = std::make_unique<DeviceQueue>(*store_, link_.get(), device_options);
   pool_ = std::make_unique<WorkPool>(options_.worker_count(), options_.queue_size);
   planning_ = std::make_unique<PlanningServiceImpl>(auth_, maps_, options_.limits, *pool_, *cache_);
@@ -71,7 +73,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   }
   server_->GetHealthCheckService()->SetServingStatus(kPlanningService, true);
   server_->GetHealthCheckService()->SetServingStatus(kCalibrationService, true);
-  queue_->start([this](bool connected) { set_device_health(connected); });
+  queue_->start([this](bool serving) { set_device_health(serving); });
   log_event("server_started", {{"listen", options_.listen},
                                {"port", port_},
                                {"workers", pool_->workers()},
@@ -84,9 +86,9 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
 
 HapticServer::~HapticServer() { shutdown(); }
 
-void HapticServer::set_device_health(bool connected) {
+void HapticServer::set_device_health(bool serving) {
   std::lock_guard lock(health_mutex_);
-  if (serving_) server_->GetHealthCheckService()->SetServingStatus(kDeviceService, connected);
+  if (serving_) server_->GetHealthCheckService()->SetServingStatus(kDeviceService, serving);
 }
 
 void HapticServer::shutdown() {

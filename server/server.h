@@ -47,7 +47,7 @@ class HapticServer {
   ResultCache& cache() { return *cache_; }
 
  private:
-  void set_device_health(bool connected);
+  void set_device_health(bool serving);
 
   ServerOptions options_;
   Authenticator auth_;

@@ -7,9 +7,10 @@ namespace hj::server {
 
 const char* const kServerUsage =
     "usage: hapticjam-server --listen HOST:PORT [--device HOST:PORT|SERIAL] [--workers N]\n"
-    "                        [--auth FILE] [--db FILE] [--tls-cert F --tls-key F]\n"
+    "                        [--auth FILE] [--db FILE] [--tls-cert F --tls-key F] [--trusted-network]\n"
     "                        [--map NAME=FILE ...] [--queue-size N] [--device-queue-size N]\n"
     "                        [--cache-size N] [--max-message-mib N] [--http HOST:PORT]\n"
+    "                        [--keep-jobs N] [--keep-days N]\n"
     "The hapticjam gRPC server (proto/hapticjam/v1): planning on a pool of simulator\n"
     "workers, and a persistent queue of jobs for the attached array.\n"
     "  --listen HOST:PORT      address to serve on; port 0 picks a free port (printed).\n"
@@ -22,6 +23,8 @@ const char* const kServerUsage =
     "                          ROLE preview | operator | admin (server/README.md)\n"
     "  --db FILE               the device queue's SQLite database (default hapticjam-queue.db)\n"
     "  --tls-cert F --tls-key F  serve TLS with this PEM certificate chain and key\n"
+    "  --trusted-network       allow --auth on a non-loopback address without TLS (the\n"
+    "                          tokens then cross the network in the clear)\n"
     "  --map NAME=FILE         a goal map (DEM table, image) clients can name and crop;\n"
     "                          repeatable\n"
     "  --queue-size N          planning requests that may wait for a worker (default 16);\n"
@@ -32,6 +35,10 @@ const char* const kServerUsage =
     "  --http HOST:PORT        also serve the web viewer there (clients/web, docs/web.md):\n"
     "                          a gateway process over this server's gRPC API; loopback\n"
     "                          only without --auth; port 0 picks one (printed)\n"
+    "  --keep-jobs N           finished device jobs (with their captures) kept, newest first\n"
+    "                          (default 1000, 0 = no bound)\n"
+    "  --keep-days N           finished device jobs older than N days are deleted (default 30,\n"
+    "                          0 = no bound)\n"
     "  --help                  this text\n"
     "Logs: one JSON object per line on stderr. SIGINT/SIGTERM shut down cleanly.\n";
 
@@ -69,6 +76,10 @@ ServerOptions parse_server_args(const std::vector<std::string>& args, bool* help
       return out;
     }
     if (a.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument \"" + a + "\"");
+    if (a == "--trusted-network") {
+      out.trusted_network = true;
+      continue;
+    }
     if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
     const std::string& v = args[++i];
     if (a == "--listen") out.listen = v;
@@ -88,6 +99,8 @@ ServerOptions parse_server_args(const std::vector<std::string>& args, bool* help
     else if (a == "--cache-size") out.cache_size = parse_count(a, v, 0, 1'000'000);
     else if (a == "--http") out.http = v;
     else if (a == "--max-message-mib") out.limits.max_message_bytes = parse_count(a, v, 1, 1024) << 20;
+    else if (a == "--keep-jobs") out.keep_jobs = parse_count(a, v, 0, 100'000'000);
+    else if (a == "--keep-days") out.keep_days = parse_count(a, v, 0, 100'000);
     else throw std::invalid_argument("unknown option " + a + " (see --help)");
   }
   out.validate();
@@ -101,6 +114,10 @@ void ServerOptions::validate() const {
     throw std::invalid_argument("--listen " + listen +
                                 " is not a loopback address: without --auth the server lets every caller do "
                                 "everything, so it listens only on 127.0.0.1, localhost or [::1]; give --auth FILE");
+  if (!auth_file.empty() && !is_loopback_listen(listen) && tls_cert.empty() && !trusted_network)
+    throw std::invalid_argument("--listen " + listen + " with --auth but without TLS would send the bearer tokens "
+                                "in the clear; give --tls-cert and --tls-key, or --trusted-network if the network "
+                                "is private");
   if (tls_cert.empty() != tls_key.empty()) throw std::invalid_argument("--tls-cert and --tls-key go together");
   if (!http.empty()) {
     if (http.rfind(':') == std::string::npos) throw std::invalid_argument("--http needs HOST:PORT, got \"" + http + "\"");

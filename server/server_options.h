@@ -18,16 +18,19 @@ struct ServerOptions {
   std::string auth_file;              // "" = no auth, loopback only
   std::string db_file = "hapticjam-queue.db";
   std::string tls_cert, tls_key;      // PEM files; both or neither
+  bool trusted_network = false;       // --auth without TLS off loopback is allowed
   std::vector<std::pair<std::string, std::string>> maps;  // NAME, FILE
   int queue_size = 16;                // planning requests that may wait for a worker
   int device_queue_size = 64;         // device jobs that may wait
   int cache_size = 256;               // planning results kept
   std::string http;                   // HOST:PORT of the web viewer (clients/web, docs/web.md); "" = none
+  int keep_jobs = 1000;               // finished device jobs kept (newest); 0 = no bound
+  int keep_days = 30;                 // finished device jobs kept no longer; 0 = no bound
   ServerLimits limits;
 
   // Throws std::invalid_argument naming the flag: no --listen, a non-loopback
-  // --listen or --http without --auth, half of the TLS pair, --http with TLS,
-  // a count out of range.
+  // --listen or --http without --auth, or with --auth but neither TLS nor
+  // --trusted-network, half of the TLS pair, --http with TLS, a count out of range.
   void validate() const;
   int worker_count() const;  // workers, or the core count
 };

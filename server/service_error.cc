@@ -1,6 +1,7 @@
 #include "service_error.h"
 
 #include "calib/model_params.h"
+#include "job_store.h"
 #include "shapes/height_map.h"
 
 namespace hj::server {
@@ -16,6 +17,8 @@ grpc::Status status_from_current_exception() {
     return {grpc::StatusCode::INVALID_ARGUMENT, e.what()};
   } catch (const ParamsError& e) {
     return {grpc::StatusCode::INVALID_ARGUMENT, e.what()};
+  } catch (const StoreError& e) {
+    return {grpc::StatusCode::UNAVAILABLE, e.what()};
   } catch (const std::exception& e) {
     return {grpc::StatusCode::INTERNAL, e.what()};
   }

@@ -21,7 +21,8 @@ class ServiceError : public std::runtime_error {
 
 // The status for an exception escaping a handler's work: ServiceError keeps
 // its code, bad input (std::invalid_argument, hj::ImportError,
-// hj::ParamsError) is INVALID_ARGUMENT, anything else INTERNAL.
+// hj::ParamsError) is INVALID_ARGUMENT, a failing job database (StoreError)
+// UNAVAILABLE, anything else INTERNAL.
 grpc::Status status_from_current_exception();
 
 }  // namespace hj::server

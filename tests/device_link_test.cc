@@ -216,12 +216,17 @@ TEST_F(DeviceLinkTest, ADropMidJobFailsThatActionAndNothingIsResent) {
                             {"dropped during", "pin 1 1", device.endpoint()});
   ASSERT_TRUE(events.reach(3));
   EXPECT_EQ(events.events(), (std::vector<bool>{true, false, true}));
-  // The dropped pin never reached the device and the link did not repeat it.
+  // The dropped pin never reached the device and the link did not repeat it;
+  // the device vented itself when the connection closed.
+  const auto received = device.server.actions_received();
+  ASSERT_EQ(received.size(), 2u);
+  EXPECT_EQ(received[1].line.substr(received[1].line.find(' ') + 1), "jam 0 0");
+  ASSERT_EQ(device.server.vents().size(), 1u);
+  EXPECT_EQ(device.server.vents()[0].why, "connection closed");
   const DeviceStatus s = link->query_status(kLong);
   EXPECT_EQ(s.node_pinned[1 * 5 + 1], 0);
-  EXPECT_EQ(s.cell_jammed[0], 1);
-  link->vent(kLong);
-  EXPECT_EQ(link->query_status(kLong).cell_jammed[0], 0);
+  EXPECT_EQ(s.cell_jammed[0], 0);
+  EXPECT_EQ(s.pressure_pa, 0.0);
 }
 
 TEST_F(DeviceLinkTest, AMuteDeviceIsFoundByTheHeartbeatAndReconnected) {

@@ -34,6 +34,7 @@ class FakeDeviceLink final : public device::DeviceLink {
   void execute(const Action& action, std::chrono::milliseconds timeout) override {
     std::unique_lock lock(mutex_);
     wait_for_turn(lock, timeout, action.describe());
+    if (halted_) throw device::DeviceError(device::DeviceError::Kind::kHalted, action.describe() + ": halted");
     log_.push_back(action.describe());
     if (action.op == Action::Op::kSetPressure) pressure_pa_ = action.pressure_pa;
   }
@@ -54,12 +55,25 @@ class FakeDeviceLink final : public device::DeviceLink {
     ++vents_;
     changed_.notify_all();
   }
+  void halt_and_vent(std::chrono::milliseconds timeout) override {
+    {
+      std::lock_guard lock(mutex_);
+      halted_ = true;
+      changed_.notify_all();
+    }
+    vent(timeout);
+  }
+  void release_halt() override {
+    std::lock_guard lock(mutex_);
+    halted_ = false;
+  }
   device::DeviceStatus status() const override {
     std::lock_guard lock(mutex_);
     device::DeviceStatus s;
     s.connected = connected_;
     s.endpoint = "fake";
     s.rows = rows_, s.cols = cols_;
+    s.cell_mm = 38.0;
     s.pressure_pa = pressure_pa_;
     s.max_pressure_pa = max_pressure_pa_;
     s.cell_jammed.assign(size_t(rows_ * cols_), 0);
@@ -128,7 +142,7 @@ class FakeDeviceLink final : public device::DeviceLink {
   const double max_pressure_pa_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  bool connected_ = false, stopped_ = false, holding_ = false;
+  bool connected_ = false, stopped_ = false, holding_ = false, halted_ = false;
   int permits_ = 0, waiting_ = 0, vents_ = 0;
   double pressure_pa_ = 0.0;
   std::vector<std::string> log_;

@@ -6,6 +6,7 @@
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/impl/codegen/client_unary_call.h>
 
+#include "expect_error.h"
 #include "server_fixture.h"
 
 namespace hj {
@@ -167,7 +168,7 @@ TEST(ServerDevice, EmergencyStopVentsAtOnceAndPauses) {
   v1::EmergencyStopRequest request;
   request.set_reason("hand on the surface");
   v1::DeviceStatus status;
-  EXPECT_EQ(s.device->EmergencyStop(call("alice-token-1").get(), request, &status).error_code(),
+  EXPECT_EQ(s.device->EmergencyStop(call("carol-token-3").get(), request, &status).error_code(),
             StatusCode::PERMISSION_DENIED);
   ASSERT_TRUE(s.device->EmergencyStop(call("root-token-444").get(), request, &status).ok());
   // Vented while the job's step was still held: the stop did not wait for the queue.
@@ -183,6 +184,30 @@ TEST(ServerDevice, EmergencyStopVentsAtOnceAndPauses) {
   submit(s, "alice-token-1", device_plan({"p 0.1"}), &refused);
   EXPECT_EQ(refused.error_code(), StatusCode::FAILED_PRECONDITION);
   s.link->free_run();
+}
+
+// A role that cannot stop the array cannot clear a stop: operators do both, previewers neither.
+TEST(ServerDevice, WhoMayStopMayResumeAndNoOneElse) {
+  ScratchDir dir;
+  AuthServer auth(dir.path);
+  TestServer s(auth.options);
+  ASSERT_TRUE(eventually([&] { return queue(s).device_connected(); }));
+  v1::EmergencyStopRequest request;
+  v1::DeviceStatus status;
+  v1::QueueState resumed;
+  EXPECT_EQ(s.device->EmergencyStop(call("carol-token-3").get(), request, &status).error_code(),
+            StatusCode::PERMISSION_DENIED);
+  ASSERT_TRUE(s.device->EmergencyStop(call("bob-token-22").get(), request, &status).ok());
+  EXPECT_TRUE(status.emergency_stopped());
+  const grpc::Status denied = s.device->ResumeQueue(call("carol-token-3").get(), {}, &resumed);
+  EXPECT_EQ(denied.error_code(), StatusCode::PERMISSION_DENIED);
+  EXPECT_NE(denied.error_message().find("operator"), std::string::npos) << denied.error_message();
+  EXPECT_TRUE(queue(s).paused());
+  ASSERT_TRUE(s.device->ResumeQueue(call("bob-token-22").get(), {}, &resumed).ok());
+  EXPECT_FALSE(resumed.paused());
+  // The halt is cleared with the stop: a job runs again.
+  const v1::Job job = submit(s, "alice-token-1", device_plan({"p 0.2"}));
+  ASSERT_TRUE(eventually([&] { return job_state_is(s, job.id(), v1::JOB_STATE_DONE); }));
 }
 
 TEST(ServerDevice, ARestartOnTheSameDatabaseKeepsTheQueueAndReportsTheRunningJobInterrupted) {
@@ -310,7 +335,13 @@ TEST(ServerDevice, HealthFollowsTheDeviceLink) {
 TEST(ServerOptions, WithoutAuthOnlyLoopbackIsAllowed) {
   bool help = false;
   EXPECT_THROW(server::parse_server_args({"--listen", "0.0.0.0:7000"}, &help), std::invalid_argument);
-  EXPECT_NO_THROW(server::parse_server_args({"--listen", "0.0.0.0:7000", "--auth", "a.txt"}, &help));
+  // Tokens never cross a network in the clear unless the operator says it is private.
+  testing_support::expect_error<std::invalid_argument>(
+      [&] { server::parse_server_args({"--listen", "0.0.0.0:7000", "--auth", "a.txt"}, &help); },
+      {"--listen 0.0.0.0:7000", "in the clear", "--trusted-network"});
+  EXPECT_NO_THROW(server::parse_server_args({"--listen", "0.0.0.0:7000", "--auth", "a.txt", "--trusted-network"}, &help));
+  EXPECT_NO_THROW(server::parse_server_args(
+      {"--listen", "0.0.0.0:7000", "--auth", "a.txt", "--tls-cert", "c.pem", "--tls-key", "k.pem"}, &help));
   EXPECT_NO_THROW(server::parse_server_args({"--listen", "[::1]:7000"}, &help));
   EXPECT_THROW(server::parse_server_args({"--listen", "127.0.0.1:1", "--tls-cert", "c.pem"}, &help),
                std::invalid_argument);
@@ -329,6 +360,18 @@ TEST(ServerOptions, AuthFileErrorsNameTheLine) {
     EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("superuser"), std::string::npos) << e.what();
   }
+}
+
+TEST(ServerOptions, ATokenFileOthersCanReadIsWarnedAbout) {
+  ScratchDir dir;
+  const auto file = dir.path / "auth.txt";
+  std::ofstream(file) << "alice operator alice-token-1\n";
+  std::filesystem::permissions(file, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  EXPECT_TRUE(server::Authenticator::from_file(file).warnings().empty());
+  std::filesystem::permissions(file, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+  const auto warnings = server::Authenticator::from_file(file).warnings();
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("readable by other users"), std::string::npos) << warnings[0];
 }
 
 }  // namespace

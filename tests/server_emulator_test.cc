@@ -1,7 +1,7 @@
 // The server with the real device link (Asio, src/device) to an in-process
 // device emulator: a job runs and its capture comes back; a dropped
 // connection mid-job interrupts it, the device is vented on reconnect and the
-// queue waits for an admin.
+// queue waits for an operator; a clean shutdown vents.
 #include <gtest/gtest.h>
 
 #include "device/make_device_link.h"
@@ -85,6 +85,20 @@ TEST(ServerWithEmulator, ADroppedConnectionInterruptsTheJobAndTheDeviceIsVentedB
   v1::QueueState resumed;
   ASSERT_TRUE(f.stub->ResumeQueue(call().get(), {}, &resumed).ok());
   ASSERT_TRUE(testing_support::eventually([&] { return f.job(second.id()).state() == v1::JOB_STATE_DONE; }, 60.0));
+}
+
+// SIGINT and SIGTERM end in shutdown(): the array is vented before the link closes.
+TEST(ServerWithEmulator, ACleanShutdownVentsTheDeviceFirst) {
+  ScratchDir dir;
+  EmulatorServerFixture f(dir.path);
+  ASSERT_TRUE(testing_support::eventually([&] { return f.status().connected(); }, 20.0));
+  const v1::Job job = f.submit(device_plan({"p 0.6", "j 0 1"}));
+  ASSERT_TRUE(testing_support::eventually([&] { return f.job(job.id()).state() == v1::JOB_STATE_DONE; }, 60.0));
+  const std::size_t vents = f.emulated.server.vents().size();
+  f.server->shutdown();
+  const auto after = f.emulated.server.vents();
+  ASSERT_GT(after.size(), vents);
+  EXPECT_EQ(after[vents].why, "vent");  // the server's own, not the device's reaction to the closed link
 }
 
 }  // namespace

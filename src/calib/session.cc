@@ -20,6 +20,9 @@ using json = nlohmann::json;
 
 constexpr std::string_view kFormat = "hapticjam.session/1";
 constexpr long long kMaxGridSamples = 25'000'000;
+// Steps of one session, checked before any is read (the array's size is
+// bounded by the mesh's own point limit).
+constexpr std::size_t kMaxSessionSteps = 100'000;
 
 // Where a message points: the file, and the step being read (if any).
 struct Context {
@@ -206,6 +209,8 @@ SessionStep read_step(const json& step, int index, const Mesh& mesh, const Surfa
 std::vector<SessionStep> read_steps(const json& root, const SessionDevice& device, const Context& ctx) {
   const json& steps = require(root, "steps", ctx, "steps");
   if (!steps.is_array()) fail(ctx, "steps", "must be an array, got " + shown(steps));
+  if (steps.size() > kMaxSessionSteps)
+    fail(ctx, "steps", std::to_string(steps.size()) + " steps is over the limit of " + std::to_string(kMaxSessionSteps));
 
   // The device's mesh, only to check cells and nodes (at the model's p = 4).
   std::optional<Mesh> mesh;

@@ -88,6 +88,10 @@ struct AsioDeviceLink::Impl {
   std::map<std::uint64_t, std::shared_ptr<Pending>> pending;
   bool up = false;
   bool stopping = false;
+  bool halted = false;  // actions are refused unsent (halt_and_vent)
+  // Vents mirrored so far: an action acknowledged before a vent but mirrored
+  // after it (its caller's thread ran late) must not undo the vent's mirror.
+  std::uint64_t vents_mirrored = 0;
   DeviceStatus status;
   std::function<void(bool)> callback;
   // Bumped (under `mutex`) on every connection attempt and every drop, so
@@ -156,6 +160,7 @@ struct AsioDeviceLink::Impl {
         std::lock_guard lock(mutex);
         status.rows = hello.rows;
         status.cols = hello.cols;
+        status.cell_mm = hello.cell_mm;
         status.max_pressure_pa = hello.max_pressure_pa;
       }
       send_internal(gen, "status", [this, gen, hello](const protocol::Reply& r) {
@@ -329,26 +334,29 @@ struct AsioDeviceLink::Impl {
 
   // --- callers' threads ----------------------------------------------------
 
-  // Sends `command` and waits for its reply: kDisconnected if the link is
-  // not up or drops, kTimeout after `timeout`, kRefused for an "err".
-  protocol::Reply request(const std::string& command, std::chrono::milliseconds timeout) {
+  // Sends `command` and waits for its reply: kHalted for an action while
+  // halted, kDisconnected if the link is not up or drops, kTimeout after
+  // `timeout`, kRefused for an "err".
+  protocol::Reply request(const std::string& command, std::chrono::milliseconds timeout, bool actuates = false) {
     const std::uint64_t id = next_id++;
     auto p = std::make_shared<Pending>();
     p->what = command;
     std::future<Outcome> outcome = p->outcome.get_future();
-    unsigned gen = 0;
     {
       std::lock_guard lock(mutex);
+      if (actuates && halted)
+        throw DeviceError(Kind::kHalted, "\"" + command + "\" not sent: the device is halted by an emergency stop");
       if (!up)
         throw DeviceError(Kind::kDisconnected, "device link to " + endpoint.to_string() + " is down; \"" + command +
                                                    "\" not sent" +
                                                    (status.last_error.empty() ? "" : " (" + status.last_error + ")"));
-      gen = generation;
       pending[id] = p;
+      // Queued for the wire under the same lock as the halt check, so the
+      // wire's order is the order of these decisions (halt_and_vent).
+      asio::post(io, [this, gen = generation.load(), line = std::to_string(id) + " " + command + "\n"]() mutable {
+        write(gen, std::move(line));
+      });
     }
-    asio::post(io, [this, gen, line = std::to_string(id) + " " + command + "\n"]() mutable {
-      write(gen, std::move(line));
-    });
     bool timed_out = false;
     if (outcome.wait_for(timeout) != std::future_status::ready) {
       std::lock_guard lock(mutex);
@@ -372,7 +380,9 @@ struct AsioDeviceLink::Impl {
       std::lock_guard lock(mutex);
       status.last_error = what;
     }
-    throw DeviceError(Kind::kRefused, what);
+    throw DeviceError(reply.code == protocol::error_code_name(protocol::ErrorCode::kCancelled) ? Kind::kVented
+                                                                                               : Kind::kRefused,
+                      what);
   }
 };
 
@@ -435,10 +445,15 @@ void AsioDeviceLink::execute(const Action& action, std::chrono::milliseconds tim
   r.action = action;
   std::string command = protocol::format_request(r);
   command = command.substr(command.find(' ') + 1);  // without the placeholder id
-  impl_->request(command, timeout);
-  // Acknowledged: mirror it.
+  std::uint64_t vents_before = 0;
+  {
+    std::lock_guard lock(impl_->mutex);
+    vents_before = impl_->vents_mirrored;
+  }
+  impl_->request(command, timeout, /*actuates=*/true);
+  // Acknowledged: mirror it, unless a vent has been mirrored since.
   std::lock_guard lock(impl_->mutex);
-  mirror_action(impl_->status, action);
+  if (impl_->vents_mirrored == vents_before) mirror_action(impl_->status, action);
 }
 
 Capture AsioDeviceLink::capture(std::chrono::milliseconds timeout) {
@@ -457,7 +472,21 @@ Capture AsioDeviceLink::capture(std::chrono::milliseconds timeout) {
 void AsioDeviceLink::vent(std::chrono::milliseconds timeout) {
   impl_->request("vent", timeout);
   std::lock_guard lock(impl_->mutex);
+  ++impl_->vents_mirrored;
   mirror_vent(impl_->status);
+}
+
+void AsioDeviceLink::halt_and_vent(std::chrono::milliseconds timeout) {
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->halted = true;
+  }
+  vent(timeout);
+}
+
+void AsioDeviceLink::release_halt() {
+  std::lock_guard lock(impl_->mutex);
+  impl_->halted = false;
 }
 
 DeviceStatus AsioDeviceLink::status() const {

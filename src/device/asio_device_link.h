@@ -33,6 +33,8 @@ class AsioDeviceLink final : public DeviceLink {
   // The device's state as last reported or acknowledged (no I/O);
   // last_error is the most recent failure (kept after a reconnect).
   DeviceStatus status() const override;
+  void halt_and_vent(std::chrono::milliseconds timeout) override;
+  void release_halt() override;
   // Callbacks run in order on a thread of the link's own (not the one doing
   // I/O), so one may send commands itself, e.g. vent() on reconnect; it must
   // not call stop().

@@ -18,10 +18,13 @@
 namespace hj::device {
 
 // A command the device refused or could not finish: a timeout, a dropped
-// link, an error the controller reported. what() names the command.
+// link, an error the controller reported, a command the device dropped
+// because it vented first (kVented: a stop or its watchdog), or an action
+// not sent because the link is halted (an emergency stop). what() names the
+// command.
 class DeviceError : public std::runtime_error {
  public:
-  enum class Kind { kTimeout, kDisconnected, kRefused };
+  enum class Kind { kTimeout, kDisconnected, kRefused, kVented, kHalted };
   DeviceError(Kind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
   Kind kind() const { return kind_; }
 
@@ -44,6 +47,7 @@ struct DeviceStatus {
   bool connected = false;
   std::string endpoint;          // "127.0.0.1:7700" or "/dev/ttyUSB0"
   int rows = 0, cols = 0;        // the array, as the controller reports it
+  double cell_mm = 0.0;          // its cell side
   double pressure_pa = 0.0;
   double max_pressure_pa = 0.0;  // the device's own limit
   std::vector<char> cell_jammed;  // rows * cols, row-major
@@ -70,6 +74,14 @@ class DeviceLink {
   // The safe state: pressure 0, every cell unjammed, every node unpinned.
   virtual void vent(std::chrono::milliseconds timeout) = 0;
   virtual DeviceStatus status() const = 0;
+
+  // The emergency stop, as one decision: from the moment it is called every
+  // execute() is refused unsent (DeviceError kHalted) until release_halt(),
+  // and a vent goes out behind whatever was already sent, so no action
+  // reaches the device after the vent. Waits for the vent's answer; throws
+  // DeviceError like vent() (the halt stays in place either way).
+  virtual void halt_and_vent(std::chrono::milliseconds timeout) = 0;
+  virtual void release_halt() = 0;
 
   // Called from the link's thread whenever the connection comes up or goes
   // down (true = connected). Set before start().

@@ -27,6 +27,9 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  options.server.on_vent = [](const std::string& why) {
+    std::fprintf(stderr, "hapticjam-device-emulator: vented (%s)\n", why.c_str());
+  };
   try {
     Emulator emulator(options.config);
     EmulatorServer server(emulator, options.server);

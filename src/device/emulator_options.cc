@@ -34,6 +34,8 @@ const char* const kEmulatorUsage =
     "                         captures (hello, ping, status, fault are not\n"
     "                         counted), close the connection on the next one,\n"
     "                         unanswered; once\n"
+    "  --watchdog-ms MS       vent by itself after MS ms without a byte from the\n"
+    "                         server while actuated, 100..5000 (default 2000)\n"
     "  --help                 this text\n"
     "Runs until SIGINT or SIGTERM.\n";
 
@@ -144,6 +146,7 @@ EmulatorProgramOptions parse_emulator_options(const std::vector<std::string>& ar
     else if (a == "--dropout") dropout = number(a, value());
     else if (a == "--seed") camera.seed = static_cast<std::uint64_t>(whole(a, value(), 0, 1LL << 62));
     else if (a == "--drop-after") out.server.drop_after = whole(a, value(), 0, 1LL << 40);
+    else if (a == "--watchdog-ms") out.server.watchdog = std::chrono::milliseconds(whole(a, value(), 100, 5000));
     else throw std::invalid_argument("unknown argument \"" + a + "\"");
   }
   if (out.help) return out;

@@ -31,19 +31,39 @@ struct Connection {
   std::array<char, 4096> buffer{};
   std::deque<std::string> out;
   bool closed = false;
+  bool actuated = false;  // it sent an action since the last vent (io thread)
+};
+
+// A device command for the worker. Without a connection it is the
+// membrane's part of a vent (the actuators were released at once).
+struct DeviceCommand {
+  std::weak_ptr<Connection> connection;
+  protocol::Request request;
+  bool answers = true;
+  bool overtaken = false;  // a vent came while it ran: answered "cancelled"
 };
 
 bool blank(std::string_view line) { return line.find_first_not_of(" \t") == std::string_view::npos; }
 
+constexpr std::size_t kMaxActionLog = 100'000;
+
+std::string overtaken_message(const protocol::Request& r, const std::string& why) {
+  std::string command = protocol::format_request(r);
+  command = command.substr(command.find(' ') + 1);
+  return "\"" + command + "\" not carried out: the device vented (" + why + ")";
+}
+
 }  // namespace
 
 struct EmulatorServer::Impl {
-  Impl(Emulator& e, EmulatorServerOptions o) : emulator(e), options(std::move(o)), acceptor(io) {}
+  Impl(Emulator& e, EmulatorServerOptions o)
+      : emulator(e), options(std::move(o)), acceptor(io), watchdog_timer(io) {}
 
   Emulator& emulator;
   const EmulatorServerOptions options;
   asio::io_context io;
   tcp::acceptor acceptor;
+  asio::steady_timer watchdog_timer;
   std::thread io_thread;
 
   // io thread only.
@@ -51,15 +71,21 @@ struct EmulatorServer::Impl {
   long counted = 0;
   bool dropped_once = false;
   Clock::time_point mute_until{};
+  Clock::time_point last_heard = Clock::now();
 
   // The device worker: one command at a time.
-  std::mutex mutex;
+  mutable std::mutex mutex;
   std::condition_variable wake;
-  std::deque<std::function<void()>> jobs;
+  std::deque<std::shared_ptr<DeviceCommand>> jobs;
+  std::shared_ptr<DeviceCommand> current;  // the command the worker is carrying out
+  bool actuated = false;                   // an action arrived since the last vent
   Clock::time_point stall_until{};
   bool stopping = false;
   std::thread worker;
   std::atomic<long> answered{0};
+  std::deque<ReceivedAction> action_log;
+  std::uint64_t actions_seen = 0;
+  std::vector<VentRecord> vent_log;
 
   void accept() {
     acceptor.async_accept([this](boost::system::error_code ec, tcp::socket socket) {
@@ -78,6 +104,7 @@ struct EmulatorServer::Impl {
     c->socket.async_read_some(asio::buffer(c->buffer), [this, c](boost::system::error_code ec, std::size_t n) {
       if (c->closed) return;
       if (ec) return close(c);
+      last_heard = Clock::now();
       c->lines.feed(
           std::string_view(c->buffer.data(), n), [&](std::string_view line) { received(c, line); },
           [&] {
@@ -117,21 +144,67 @@ struct EmulatorServer::Impl {
       }
       ++counted;
     }
-    std::weak_ptr<Connection> weak = c;
-    std::lock_guard lock(mutex);
-    jobs.push_back([this, weak, r] {
-      std::string reply;
-      try {
-        reply = emulator.handle(r);
-      } catch (const std::exception& e) {  // a failure of the device, not of the server
-        reply = protocol::format_err(r.id, protocol::ErrorCode::kFailed, e.what());
-      }
+    if (r.command == Command::kVent) {
+      vent_at_once("vent");
       ++answered;
-      asio::post(io, [this, weak, reply = std::move(reply)] {
-        if (const auto c = weak.lock()) write(c, reply);
-      });
-    });
+      return write(c, protocol::format_ok(r.id));
+    }
+    auto command = std::make_shared<DeviceCommand>();
+    command->connection = c;
+    command->request = r;
+    if (r.command == Command::kAction) c->actuated = true;
+    std::lock_guard lock(mutex);
+    if (r.command == Command::kAction) record_action(line);
+    jobs.push_back(std::move(command));
     wake.notify_all();
+  }
+
+  // With `mutex` held.
+  void record_action(std::string_view line) {
+    actuated = true;
+    action_log.push_back({++actions_seen, Clock::now(), std::string(line)});
+    if (action_log.size() > kMaxActionLog) action_log.pop_front();
+  }
+
+  // The controller's safety path (io thread): every actuator is released
+  // now; commands not yet begun, and one in progress, are answered
+  // "cancelled"; the membrane relaxes on the worker before anything else.
+  void vent_at_once(const std::string& why) {
+    for (const auto& c : connections) c->actuated = false;
+    std::deque<std::shared_ptr<DeviceCommand>> overtaken;
+    {
+      std::lock_guard lock(mutex);
+      overtaken.swap(jobs);
+      if (current) current->overtaken = true;
+      auto relax = std::make_shared<DeviceCommand>();
+      relax->request.command = protocol::Command::kVent;
+      relax->answers = false;
+      jobs.push_back(std::move(relax));
+      actuated = false;
+      vent_log.push_back({Clock::now(), why});
+      wake.notify_all();
+    }
+    for (const auto& command : overtaken)
+      if (const auto c = command->connection.lock(); c && command->answers)
+        write(c, protocol::format_err(command->request.id, protocol::ErrorCode::kCancelled,
+                                      overtaken_message(command->request, why)));
+    if (options.on_vent) options.on_vent(why);
+  }
+
+  void watch() {
+    const auto period = std::max(std::chrono::milliseconds(10), options.watchdog / 10);
+    watchdog_timer.expires_after(period);
+    watchdog_timer.async_wait([this](boost::system::error_code ec) {
+      if (ec) return;
+      bool armed = false;
+      {
+        std::lock_guard lock(mutex);
+        armed = actuated;
+      }
+      if (armed && Clock::now() - last_heard > options.watchdog)
+        vent_at_once("watchdog: nothing heard for " + std::to_string(options.watchdog.count()) + " ms");
+      watch();
+    });
   }
 
   void write(const std::shared_ptr<Connection>& c, const std::string& line) {
@@ -149,6 +222,9 @@ struct EmulatorServer::Impl {
     });
   }
 
+  // A closed connection counts as silence: if it actuated the array since
+  // the last vent, the array vents at once (and nothing it queued is
+  // carried out). Another connection closing (a tool's) changes nothing.
   void close(const std::shared_ptr<Connection>& c) {
     if (c->closed) return;
     c->closed = true;
@@ -156,6 +232,7 @@ struct EmulatorServer::Impl {
     c->socket.shutdown(tcp::socket::shutdown_both, ignored);
     c->socket.close(ignored);
     connections.erase(c);
+    if (c->actuated) vent_at_once("connection closed");
   }
 
   void stall(std::chrono::milliseconds duration) {
@@ -172,17 +249,43 @@ struct EmulatorServer::Impl {
       // A stall holds commands (they are answered when it ends).
       while (!stopping && Clock::now() < stall_until) wake.wait_until(lock, stall_until);
       if (stopping) return;
-      auto job = std::move(jobs.front());
+      if (jobs.empty()) continue;  // a vent answered them while the stall held them
+      current = std::move(jobs.front());
       jobs.pop_front();
       lock.unlock();
-      job();
+      carry_out(*current);
       lock.lock();
+      const std::shared_ptr<DeviceCommand> done = std::move(current);
+      current.reset();
+      if (!done->answers) continue;
+      const protocol::Request& r = done->request;
+      std::string reply = done->overtaken ? protocol::format_err(r.id, protocol::ErrorCode::kCancelled,
+                                                                 overtaken_message(r, "a vent came during it"))
+                                          : std::move(last_reply);
+      ++answered;
+      asio::post(io, [this, weak = done->connection, reply = std::move(reply)] {
+        if (const auto c = weak.lock()) write(c, reply);
+      });
+    }
+  }
+
+  std::string last_reply;  // worker thread only
+
+  void carry_out(const DeviceCommand& command) {
+    try {
+      last_reply = emulator.handle(command.request);
+    } catch (const std::exception& e) {  // a failure of the device, not of the server
+      last_reply = protocol::format_err(command.request.id, protocol::ErrorCode::kFailed, e.what());
     }
   }
 };
 
 EmulatorServer::EmulatorServer(Emulator& emulator, EmulatorServerOptions options)
     : impl_(std::make_unique<Impl>(emulator, std::move(options))) {
+  const auto watchdog = impl_->options.watchdog;
+  if (watchdog < std::chrono::milliseconds(10) || watchdog > std::chrono::milliseconds(5000))
+    throw std::invalid_argument("emulator watchdog of " + std::to_string(watchdog.count()) +
+                                " ms: must be within 10..5000 ms");
   const std::string where = impl_->options.host + ":" + std::to_string(impl_->options.port);
   try {
     tcp::resolver resolver(impl_->io);
@@ -205,6 +308,7 @@ unsigned short EmulatorServer::port() const { return impl_->acceptor.local_endpo
 void EmulatorServer::start() {
   if (impl_->io_thread.joinable()) return;
   impl_->accept();
+  impl_->watch();
   impl_->worker = std::thread([this] { impl_->work(); });
   impl_->io_thread = std::thread([this] { impl_->io.run(); });
 }
@@ -214,6 +318,7 @@ void EmulatorServer::stop() {
   asio::post(impl_->io, [this] {
     boost::system::error_code ignored;
     impl_->acceptor.close(ignored);
+    impl_->watchdog_timer.cancel();
     for (const auto& c : std::set<std::shared_ptr<Connection>>(impl_->connections)) impl_->close(c);
     impl_->io.stop();
   });
@@ -239,5 +344,15 @@ void EmulatorServer::mute(std::chrono::milliseconds duration) {
 }
 
 long EmulatorServer::commands_answered() const { return impl_->answered; }
+
+std::vector<ReceivedAction> EmulatorServer::actions_received() const {
+  std::lock_guard lock(impl_->mutex);
+  return {impl_->action_log.begin(), impl_->action_log.end()};
+}
+
+std::vector<VentRecord> EmulatorServer::vents() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->vent_log;
+}
 
 }  // namespace hj::device

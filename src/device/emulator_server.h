@@ -1,13 +1,19 @@
 // The emulator on the network: accepts protocol connections on TCP and
-// feeds their requests, one at a time in arrival order, to an Emulator on
-// its own worker thread, while "hello" and "ping" are answered at once (a
-// controller keeps its heartbeat while it actuates). It can misbehave on
+// feeds their device commands, one at a time in arrival order, to an
+// Emulator on its own worker thread, while "hello" and "ping" are answered at
+// once (a controller keeps its heartbeat while it actuates). A "vent" is a
+// controller's safety path: it overtakes the queue and any settle in
+// progress, and the emulator vents by itself on silence (its watchdog) or a
+// closed connection (PROTOCOL.md, "Vent and watchdog"). It can misbehave on
 // purpose for tests (PROTOCOL.md, "Faults").
 #pragma once
 
 #include <chrono>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "device/emulator.h"
 
@@ -20,6 +26,24 @@ struct EmulatorServerOptions {
   // status and fault are not counted), close the connection on the next
   // one without answering it; once. -1: never.
   long drop_after = -1;
+  // The watchdog: vent by itself after this long without a byte from any
+  // connection while the array is actuated (PROTOCOL.md: at most 5 s).
+  std::chrono::milliseconds watchdog{2000};
+  // Told every vent, with its cause ("vent", "watchdog: ...", "connection closed").
+  std::function<void(const std::string& why)> on_vent;
+};
+
+// An actuating command as it arrived, for tests that check what the device
+// was sent and when.
+struct ReceivedAction {
+  std::uint64_t sequence = 0;  // from 1, over every action this server received
+  std::chrono::steady_clock::time_point at;
+  std::string line;
+};
+
+struct VentRecord {
+  std::chrono::steady_clock::time_point at;
+  std::string why;
 };
 
 class EmulatorServer {
@@ -43,6 +67,9 @@ class EmulatorServer {
 
   // Device commands answered so far.
   long commands_answered() const;
+  // The last actions received (at most 100,000) and every vent, oldest first.
+  std::vector<ReceivedAction> actions_received() const;
+  std::vector<VentRecord> vents() const;
 
  private:
   struct Impl;

@@ -191,6 +191,7 @@ const char* error_code_name(ErrorCode code) {
     case ErrorCode::kOutOfRange: return "out_of_range";
     case ErrorCode::kUnsafe: return "unsafe";
     case ErrorCode::kFailed: return "failed";
+    case ErrorCode::kCancelled: return "cancelled";
   }
   return "failed";
 }

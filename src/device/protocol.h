@@ -26,7 +26,7 @@ constexpr std::size_t kMaxReplyBytes = 32u << 20;
 constexpr long kMaxCaptureSamples = 2'000'000;
 
 // The CODE of an "err" reply.
-enum class ErrorCode { kMalformed, kUnknownCommand, kTooLong, kOutOfRange, kUnsafe, kFailed };
+enum class ErrorCode { kMalformed, kUnknownCommand, kTooLong, kOutOfRange, kUnsafe, kFailed, kCancelled };
 const char* error_code_name(ErrorCode code);
 
 // A line that is not a valid request or reply. `id` is the request id when

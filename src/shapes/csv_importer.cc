@@ -41,6 +41,11 @@ double parse_field(const std::filesystem::path& file, long line, long column, st
   return value;
 }
 
+ImportError too_many_values(const std::filesystem::path& file, const ImportOptions& options, long line) {
+  return ImportError(file, "more than " + std::to_string(options.max_pixels) + " values (ImportOptions.max_pixels) by line " +
+                               std::to_string(line));
+}
+
 class CsvImporter final : public GoalImporter {
  public:
   std::string name() const override { return "csv"; }
@@ -69,6 +74,8 @@ class CsvImporter final : public GoalImporter {
         const std::size_t comma = line.find(',', start);
         const double v = parse_field(file, line_no, ++column, std::string_view(line).substr(start, comma - start));
         any_valid = any_valid || !std::isnan(v);
+        // Counted as the fields come, so one endless line is stopped too.
+        if (long(values.size()) >= options.max_pixels) throw too_many_values(file, options, line_no);
         values.push_back(v);
         if (comma == std::string::npos) break;
         start = comma + 1;
@@ -78,9 +85,6 @@ class CsvImporter final : public GoalImporter {
         throw ImportError(file, "line " + std::to_string(line_no) + " has " + std::to_string(column) +
                                     " values, the first row has " + std::to_string(cols) + " (rows must be equally long)");
       ++rows;
-      if (rows * cols > options.max_pixels)
-        throw ImportError(file, "more than " + std::to_string(options.max_pixels) +
-                                    " values (ImportOptions.max_pixels) by line " + std::to_string(line_no));
     }
     if (in.bad()) throw ImportError(file, "reading failed after line " + std::to_string(line_no));
     if (rows == 0) throw ImportError(file, "the file is empty (no data rows)");

@@ -38,7 +38,15 @@ void check_pixel_count(const std::filesystem::path& file, long rows, long cols, 
                                 std::to_string(options.max_pixels) + " (ImportOptions.max_pixels)");
 }
 
-cv::Mat decode(const std::filesystem::path& file) {
+// Decodes only what its header sized first: OpenCV picks the decoder by
+// the bytes, not the name, so a JPEG, BMP or PNM named .png would be
+// decoded at any size; only PNG and classic TIFF signatures are accepted.
+cv::Mat decode(const std::filesystem::path& file, const ImportOptions& options) {
+  const auto size = peek_image_size(file);
+  if (!size)
+    throw ImportError(file, "not a readable PNG or TIFF image by its content (its header is missing, cut short or "
+                            "of another format)");
+  check_pixel_count(file, size->rows, size->cols, options);
   cv::Mat image;
   try {
     image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
@@ -105,10 +113,10 @@ void apply_alpha(const cv::Mat& image, Eigen::MatrixXd& z) {
 }
 
 // NAME_validmask.png next to NAME.ext: pixels where the mask is 0 carry no data.
-void apply_validmask(const std::filesystem::path& file, Eigen::MatrixXd& z) {
+void apply_validmask(const std::filesystem::path& file, const ImportOptions& options, Eigen::MatrixXd& z) {
   const auto mask_file = file.parent_path() / (file.stem().string() + "_validmask.png");
   if (!std::filesystem::is_regular_file(mask_file)) return;
-  const cv::Mat mask = decode(mask_file);
+  const cv::Mat mask = decode(mask_file, options);
   if (mask.rows != z.rows() || mask.cols != z.cols())
     throw ImportError(file, "its validity mask \"" + mask_file.string() + "\" is " + std::to_string(mask.cols) +
                                 " x " + std::to_string(mask.rows) + " pixels, the image " +
@@ -133,8 +141,7 @@ class PngImporter final : public GoalImporter {
 }  // namespace
 
 HeightMap import_image(const std::filesystem::path& file, const ImportOptions& options) {
-  if (const auto size = peek_image_size(file)) check_pixel_count(file, size->rows, size->cols, options);
-  const cv::Mat image = decode(file);
+  const cv::Mat image = decode(file, options);
   check_pixel_count(file, image.rows, image.cols, options);
   if (image.channels() > 4) throw ImportError(file, std::to_string(image.channels()) + " channels, at most 4 are understood");
   HeightMap map;
@@ -145,7 +152,7 @@ HeightMap import_image(const std::filesystem::path& file, const ImportOptions& o
     map.z = options.hue ? hue_heights(file, image) : grey_heights(image);
     apply_alpha(image, map.z);
   }
-  apply_validmask(file, map.z);
+  apply_validmask(file, options, map.z);
   if (map.z.array().isNaN().all())
     throw ImportError(file, options.hue ? "no pixel has a clear hue (hue mode needs saturated colours)"
                                         : "every pixel is NaN, transparent or masked out (no data)");

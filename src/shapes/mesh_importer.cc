@@ -1,13 +1,16 @@
 // Mesh goal importer: Assimp reads the file, top_view.h renders it.
 #include "shapes/mesh_importer.h"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <system_error>
 
 namespace hj {
 namespace {
@@ -29,6 +32,66 @@ long count_triangles(const aiScene& scene) {
     for (unsigned f = 0; f < scene.mMeshes[m]->mNumFaces; ++f) n += scene.mMeshes[m]->mFaces[f].mNumIndices == 3;
   return n;
 }
+
+// The triangles the file will become once its polygons are triangulated and
+// every instance of a mesh is copied into place, counted on the raw scene
+// (before post-processing allocates them). Saturates above `limit`.
+long triangles_after_processing(const aiScene& scene, long limit) {
+  std::vector<long> per_mesh(scene.mNumMeshes, 0);
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m)
+    for (unsigned f = 0; f < scene.mMeshes[m]->mNumFaces; ++f)
+      per_mesh[m] += std::max(0L, long(scene.mMeshes[m]->mFaces[f].mNumIndices) - 2);
+  long total = 0;
+  std::vector<const aiNode*> nodes = {scene.mRootNode};
+  while (!nodes.empty() && total <= limit) {
+    const aiNode* node = nodes.back();
+    nodes.pop_back();
+    if (node == nullptr) continue;
+    for (unsigned i = 0; i < node->mNumMeshes; ++i)
+      if (node->mMeshes[i] < scene.mNumMeshes) total += per_mesh[node->mMeshes[i]];
+    for (unsigned c = 0; c < node->mNumChildren; ++c) nodes.push_back(node->mChildren[c]);
+  }
+  return total;
+}
+
+// Assimp's file access, confined to the folder of the mesh being imported:
+// a file the mesh names (a glTF buffer or image, an OBJ material library) is
+// read only from inside that folder, never through "..", an absolute path
+// elsewhere or a URI. The server gives each upload a folder of its own.
+class ConfinedIOSystem final : public Assimp::DefaultIOSystem {
+ public:
+  explicit ConfinedIOSystem(const std::filesystem::path& file)
+      : folder_(std::filesystem::weakly_canonical(std::filesystem::absolute(file).parent_path())) {}
+
+  bool Exists(const char* path) const override {
+    if (!inside(path)) return refuse(path);
+    return DefaultIOSystem::Exists(path);
+  }
+  Assimp::IOStream* Open(const char* path, const char* mode) override {
+    if (!inside(path) || std::string(mode).find_first_of("wa+") != std::string::npos) return refuse(path), nullptr;
+    return DefaultIOSystem::Open(path, mode);
+  }
+  // The first path refused, "" if none.
+  const std::string& refused() const { return refused_; }
+
+ private:
+  bool refuse(const char* path) const {
+    if (refused_.empty()) refused_ = path;
+    return false;
+  }
+  bool inside(const std::string& path) const {
+    // A URI, or an absolute path the importer appended to the mesh's folder.
+    if (path.find("//") != std::string::npos) return false;
+    std::error_code error;
+    const std::filesystem::path target = std::filesystem::weakly_canonical(std::filesystem::absolute(path), error);
+    if (error) return false;
+    const auto [end, rest] = std::mismatch(folder_.begin(), folder_.end(), target.begin(), target.end());
+    return end == folder_.end() && rest != target.end();
+  }
+
+  std::filesystem::path folder_;
+  mutable std::string refused_;
+};
 
 class MeshImporter final : public GoalImporter {
  public:
@@ -65,10 +128,23 @@ class MeshImporter final : public GoalImporter {
 
 std::vector<Triangle3d> load_mesh_triangles(const std::filesystem::path& file, const ImportOptions& options) {
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(
-      file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices);
+  auto* io = new ConfinedIOSystem(file);
+  importer.SetIOHandler(io);  // the importer owns it
+  const aiScene* scene = importer.ReadFile(file.string(), 0);
+  if (!io->refused().empty())
+    throw ImportError(file, "it names a file outside its upload, \"" + io->refused() +
+                                "\": external buffers, images and material files must sit beside the mesh (no \"..\", "
+                                "absolute paths or URIs)");
   if (scene == nullptr) throw ImportError(file, std::string("Assimp cannot read it: ") + importer.GetErrorString());
   if (scene->mNumMeshes == 0) throw ImportError(file, "it holds no meshes");
+  // Instancing can multiply a small file: count before the copies are made.
+  if (const long planned = triangles_after_processing(*scene, kMaxMeshTriangles); planned > kMaxMeshTriangles)
+    throw ImportError(file, "at least " + std::to_string(planned) +
+                                " triangles once every instance is placed, over the limit of " +
+                                std::to_string(kMaxMeshTriangles));
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                       aiProcess_PreTransformVertices);
+  if (scene == nullptr) throw ImportError(file, std::string("Assimp cannot process it: ") + importer.GetErrorString());
   const long n = count_triangles(*scene);
   if (n == 0) throw ImportError(file, "it holds no triangles (only points or lines)");
   if (n > kMaxMeshTriangles)

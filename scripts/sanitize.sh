@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Builds everything with AddressSanitizer and UndefinedBehaviorSanitizer
+# (CMake option HJ_SANITIZE) in BUILD_DIR (default build-asan) and runs the
+# whole test suite there. CPU-heavy: not part of .ci/run.
+# LEAKS=1 also reports leaks (off by default: gRPC, GDAL and OpenCV keep
+# allocations alive until exit).
+# Usage: scripts/sanitize.sh [BUILD_DIR] [extra ctest arguments...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build="${1:-build-asan}"
+shift $(( $# > 0 ? 1 : 0 ))
+cmake -S . -B "$build" -G Ninja -DHJ_SANITIZE=ON -DHJ_BUILD_BENCHMARKS=OFF
+cmake --build "$build" -j2
+export ASAN_OPTIONS="detect_leaks=${LEAKS:-0}:abort_on_error=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+ctest --test-dir "$build" -j2 --output-on-failure "$@"
