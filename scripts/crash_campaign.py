@@ -98,8 +98,8 @@ def check_restart(client, log_lines, had_running):
     """The first queue state after a restart, before anyone resumed."""
     problems = []
     state = next(client.watch(recent_finished=0, timeout=10))
-    if any(job.state == RUNNING for job in state.jobs):
-        problems.append("a job is `running` after the restart")
+    if had_running and any(job.state == RUNNING for job in state.jobs):
+        problems.append("a job is `running` after a restart that found one cut short")
     if had_running and not state.paused:
         problems.append("a job was cut short but the queue is not paused")
     return problems, state
@@ -132,19 +132,27 @@ def main():
               "not_vented_first": 0, "integrity_failures": 0, "problems": 0}
     try:
         for round_ in range(kills + 1):
+            cut_short = []
+            if os.path.exists(db):
+                with sqlite3.connect(db) as connection:
+                    cut_short = [r[0] for r in connection.execute("SELECT id FROM jobs WHERE state = ?", (RUNNING,))]
             log_path = os.path.join(work, f"server-{round_}.log")
             with open(log_path, "w") as log:
                 server = subprocess.Popen([f"{build}/server/hapticjam-server", "--listen", "127.0.0.1:0", "--device",
-                                           f"127.0.0.1:{device_port}", "--db", db, "--workers", "1"],
+                                           f"127.0.0.1:{device_port}", "--db", db, "--workers", "1",
+                                           "--keep-jobs", "0", "--keep-days", "0"],
                                           stdout=subprocess.PIPE, stderr=log, text=True)
                 line = server.stdout.readline()
                 port = int(re.search(r"port (\d+)", line).group(1))
                 with sqlite3.connect(db) as connection:
-                    had_running = connection.execute(
-                        "SELECT COUNT(*) FROM jobs WHERE state = ? AND error = 'the server stopped while the job ran'"
-                        " AND finished_unix_ms >= ?", (INTERRUPTED, int((time.time() - 5) * 1000))).fetchone()[0] > 0
+                    # Jobs `running` in the database once the server is up: the restart must have ended them all.
+                    still_running = connection.execute("SELECT COUNT(*) FROM jobs WHERE state = ?",
+                                                       (RUNNING,)).fetchone()[0]
+                had_running = bool(cut_short)
                 with Client(f"127.0.0.1:{port}") as client:
                     problems, _ = check_restart(client, None, had_running)
+                if still_running and had_running:
+                    problems.append(f"{still_running} jobs still `running` in the database after the restart")
                 counts["cut_short_jobs_found"] += had_running
                 counts["running_after_restart"] += any("running" in p for p in problems)
                 counts["not_paused_after_fault"] += any("paused" in p for p in problems)
