@@ -46,11 +46,16 @@ void expect_matches_device_made_goal(const ArrayGeometry& g) {
 TEST(Portfolio, MatchesADeviceMadeGoalAt6x8) { expect_matches_device_made_goal({6, 8, 0.038, 4}); }
 TEST(Portfolio, MatchesADeviceMadeGoalAt9x12) { expect_matches_device_made_goal({9, 12, 0.038, 4}); }
 
+// The shared volcano DEM at the array's default relief, scored against its image.
+PlanRequest volcano_request(const ArrayGeometry& g) {
+  const HeightMap volcano = import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
+  return {g, SurfaceParameters::paper_defaults(g), resample_to_mesh(volcano, Mesh(g)), {}, volcano.z};
+}
+
 TEST(Portfolio, IsNeverBelowAlgorithm2AndSaysWhatItChose) {
   const ArrayGeometry g{3, 4, 0.038, 4};
   const Mesh mesh(g);
-  const HeightMap volcano = import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
-  const PlanRequest request{g, SurfaceParameters::paper_defaults(g), resample_to_mesh(volcano, mesh), {}, volcano.z};
+  const PlanRequest request = volcano_request(g);
   const PlanResult paper = make_planner("algorithm2")->plan(request);
   int snapshots = 0;
   PlanCallbacks callbacks;
@@ -69,8 +74,7 @@ TEST(RefusedActions, ADeadEndIsRecordedAndThePlanFinishes) {
   // the model, not of a solver budget); those steps are refused.
   const ArrayGeometry g{5, 8, 0.038, 4};
   const Mesh mesh(g);
-  const HeightMap volcano = import_goal(HJ_SHARED_DIR "/data/dem/volcano_maunga_whau.csv");
-  const PlanRequest request{g, SurfaceParameters::paper_defaults(g), resample_to_mesh(volcano, mesh), {}, volcano.z};
+  const PlanRequest request = volcano_request(g);
   const PlanResult plan = make_planner("algorithm2")->plan(request);
   ASSERT_FALSE(plan.refused.empty());
   for (const RefusedAction& r : plan.refused) {
