@@ -132,11 +132,12 @@ TEST(SweepCli, WritesTheTableTheFitAndBothFigures) {
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_text(dir.path / "stderr.txt");
   const std::string table = read_text(out / "sweep.csv");
   EXPECT_EQ(table.substr(0, table.find('\n')),
-            "goal,rows,cols,cells,correlation,laplace_mean_a0,laplace_mean_a1_6,laplace_mean_a1_3,laplace_mean_a1_2,"
-            "laplace_mean_a1,steps,seconds,status,detail");
+            "goal,rows,cols,cells,correlation,laplace_mean_a0,laplace_mean_a1_8,laplace_mean_a1_4,laplace_mean_a1_2,"
+            "laplace_mean_a1,steps,refused,relief_mm,seconds,status,detail");
   EXPECT_NE(table.find("bump,2,3,6,"), std::string::npos);
   const std::string t2 = read_text(out / "table2.csv");
-  EXPECT_EQ(t2.substr(0, t2.find('\n')), "alpha_l,slope,intercept,r2,n");
+  EXPECT_EQ(t2.substr(0, t2.find('\n')), "alpha_l,slope,intercept,r2,n,paper_r2");
+  EXPECT_NE(t2.find("0.7583"), std::string::npos);  // the paper's r^2 at alpha_L = 1/8
   EXPECT_TRUE(fs::file_size(out / "fig11_correlation_vs_cells.png") > 1000);
   EXPECT_TRUE(fs::file_size(out / "fig13_correlation_vs_laplace.png") > 1000);
   EXPECT_NE(read_text(dir.path / "stdout.txt").find("Table 2 analogue"), std::string::npos);
