@@ -24,6 +24,8 @@ struct Variant {
 constexpr double kPinToleranceMm = 0.5;
 constexpr double kPinToleranceFraction = 0.02;
 constexpr double kMinStepPa = 1.0;
+// Doublings of a refused step of a free net tried before halving it.
+constexpr int kMaxJumps = 3;
 // End pressures tried, as multiples of the levelling pressure, from high to low.
 constexpr double kEndPressureFactors[] = {4.0, 3.0, 2.0, 1.5, 1.25, 1.1, 1.02};
 
@@ -56,13 +58,22 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
     return false;
   };
   double previous = 0.0, step = v.increment_pa;
+  int jumps = 0;
   while (previous < p_max) {
     const double pressure = std::min(previous + step, p_max);
     if (!apply(pressure)) {
+      // A free net folds only where it is slack, just past levelling on a
+      // large array: more pressure tautens it. Anything jammed or pinned: smaller steps.
+      if (is_free_net(mesh, sim.state()) && jumps < kMaxJumps && pressure < p_max) {
+        step *= 2.0;
+        ++jumps;
+        continue;
+      }
       if (step <= kMinStepPa) break;
       step /= 2.0;
       continue;
     }
+    jumps = 0;
     if (v.bisect_pins && step > kMinStepPa && overshoots() && apply(previous)) {
       step /= 2.0;
       continue;

@@ -16,6 +16,7 @@
 // See algorithm2_refined.cc.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "plan/planner.h"
@@ -30,6 +31,7 @@ struct Algorithm2RefinedOptions {
   // target (algorithm2_refined.cc gives the tolerance), so pins land on it.
   std::vector<bool> bisect_pins{true};
   double max_pressure_pa = 0.0;  // 0: the device's maximum
+  std::string name = "algorithm2-refined";  // a registered configuration's own name
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -37,7 +39,7 @@ struct Algorithm2RefinedOptions {
 class Algorithm2Refined final : public Planner {
  public:
   explicit Algorithm2Refined(Algorithm2RefinedOptions options = {});
-  std::string name() const override { return "algorithm2-refined"; }
+  std::string name() const override { return options_.name; }
   PlanResult plan(const PlanRequest& request, const PlanCallbacks& callbacks = {}) const override;
 
  private:

@@ -1,6 +1,7 @@
 #include "plan/planner.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -59,6 +60,9 @@ SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbac
   // No explicit Euler fallback: a settle that the static solver and the
   // implicit flow cannot finish is a dead end (refused), found in seconds.
   options.fallback_max_steps = 0;
+  // The longest settles a plan keeps take about a hundred solver steps (the
+  // first jammed steps past levelling on 7 x 10); a dead end is cut off soon after.
+  options.max_settle_steps = kPlannerSettleSteps;
   return options;
 }
 
@@ -82,11 +86,15 @@ void apply_planned(Simulator& sim, const Action& action, PlanResult& result, con
 }
 
 bool try_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   try {
     apply_planned(sim, action, result, callbacks);
+    result.settle_seconds += seconds();
     return true;
   } catch (const NoEquilibrium& e) {
     result.refused.push_back({action, e.what(), int(result.steps.size())});
+    result.refused_seconds += seconds();
     return false;
   }
 }
@@ -124,6 +132,16 @@ bool every_cell_jammed(const Mesh& mesh, const DeviceState& state) {
   for (int r = 0; r < mesh.rows(); ++r)
     for (int c = 0; c < mesh.cols(); ++c)
       if (!state.jammed(mesh, r, c)) return false;
+  return true;
+}
+
+bool is_free_net(const Mesh& mesh, const DeviceState& state) {
+  for (int r = 0; r < mesh.rows(); ++r)
+    for (int c = 0; c < mesh.cols(); ++c)
+      if (state.jammed(mesh, r, c)) return false;
+  for (int a = 1; a < mesh.rows(); ++a)
+    for (int b = 1; b < mesh.cols(); ++b)
+      if (state.pinned(mesh, a, b)) return false;
   return true;
 }
 

@@ -50,6 +50,10 @@ struct PlanResult {
   std::vector<Action> steps;  // in the order to apply them, from rest
   DeviceState final_state;    // the predicted surface
   std::vector<RefusedAction> refused;
+  // Wall time of the settles the plan kept and of those it refused, s:
+  // where the planner's time went.
+  double settle_seconds = 0.0;
+  double refused_seconds = 0.0;
   // How the planner came to it, for people (e.g. the strategy a portfolio
   // chose and the scores of the others); may be empty.
   std::string note;
@@ -79,6 +83,9 @@ void register_planner(const std::string& name, std::function<std::unique_ptr<Pla
 // between actions (catch SettleInterrupted, throw PlanCancelled); folded
 // equilibria refused (SimulatorOptions::refuse_folded); no explicit fallback.
 SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbacks& callbacks);
+// Solver steps a planner's settle may take before the action is refused as a
+// dead end (SimulatorOptions::max_settle_steps).
+constexpr int kPlannerSettleSteps = 150;
 
 // The request's simulator settled at rest, its settles cancellable
 // (SettleInterrupted becomes PlanCancelled).
@@ -109,6 +116,8 @@ bool jam_reached_cells(Simulator& sim, const Eigen::MatrixXd& goal_curvature, Re
                        const PlanCallbacks& callbacks);
 // True if every cell of the state is jammed.
 bool every_cell_jammed(const Mesh& mesh, const DeviceState& state);
+// Nothing jammed and nothing pinned.
+bool is_free_net(const Mesh& mesh, const DeviceState& state);
 
 // The goal as a surface on the mesh: rest positions with z = scale * goal_mm / 1000 (3 x N, m).
 Eigen::Matrix3Xd goal_positions(const Mesh& mesh, const Eigen::MatrixXd& goal_mm, double scale = 1.0);

@@ -10,22 +10,12 @@
 #include <thread>
 
 #include "plan/algorithm2.h"
-#include "plan/algorithm2_refined.h"
+#include "plan/algorithm2_levelled.h"
 #include "plan/from_above.h"
 
 namespace hj {
 
 namespace {
-
-// Algorithm 2 aiming at `scale` times the goal, pins landing on their
-// targets, no jam below the levelling pressure (a jam in the deep sag is
-// what folds large arrays later), ending with the scan of end pressures.
-std::unique_ptr<Planner> refined_variant(double scale) {
-  Algorithm2RefinedOptions o;
-  o.height_scales = {scale};
-  o.jam_below_levelling = {false};
-  return std::make_unique<Algorithm2Refined>(o);
-}
 
 struct StrategyOutcome {
   std::optional<PlanResult> result;
@@ -44,10 +34,9 @@ Portfolio::Portfolio(PortfolioOptions options) : options_(options) { options_.va
 std::vector<std::pair<std::string, std::unique_ptr<Planner>>> Portfolio::strategies() {
   std::vector<std::pair<std::string, std::unique_ptr<Planner>>> out;
   out.emplace_back("algorithm2", std::make_unique<Algorithm2>());
+  out.emplace_back("algorithm2-levelled x1", make_algorithm2_levelled(1.0));
+  out.emplace_back("algorithm2-levelled x2", make_algorithm2_levelled(2.0));
   out.emplace_back("from-above", std::make_unique<FromAbove>());
-  out.emplace_back("above levelling x1", refined_variant(1.0));
-  out.emplace_back("above levelling x2", refined_variant(2.0));
-  out.emplace_back("above levelling x3", refined_variant(3.0));
   return out;
 }
 

@@ -2,10 +2,9 @@
 // keeps the plan whose surface scores best (plan_score: Eq. 12 against the
 // goal image when the request has it). The paper's Algorithm 2 is one of
 // them, so the result is never worse than Algorithm 2's by that score. The
-// others: from-above (from_above.h), and Algorithm 2 variants
-// (algorithm2_refined.h) that jam no cell below the levelling pressure and
-// aim at 1, 2 and 3 times the goal, with pins landing on their targets and
-// a scan of end pressures. See portfolio.cc.
+// others: algorithm2-levelled (algorithm2_levelled.h: no jam below the
+// levelling pressure) aiming at 1 and 2 times the goal, and from-above
+// (from_above.h). See portfolio.cc.
 #pragma once
 
 #include <memory>

@@ -38,9 +38,9 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
     throw std::invalid_argument("simulator option refuse_fold_deg (degrees) must lie in [90, 180]");
   if (options_.fallback_max_steps < 0)
     throw std::invalid_argument("simulator option fallback_max_steps must be >= 0 (0: no explicit fallback)");
-  if (options_.interrupted)
-    options_.static_options.interrupted = options_.explicit_options.interrupted = options_.flow_options.interrupted =
-        options_.interrupted;
+  if (options_.max_settle_steps < 0)
+    throw std::invalid_argument("simulator option max_settle_steps must be >= 0 (0: no limit)");
+  install_poll();
   // Below this many free DOFs a settle step costs well under a millisecond
   // and the mirrored start's few steps are not worth a second mesh.
   constexpr int kCoarseStartMinDofs = 1500;
@@ -177,6 +177,18 @@ void Simulator::settle_fallbacks(const Eigen::Matrix3Xd& before) {
   polish(settle_explicit(model_, state_, fallback), spent);
 }
 
+void Simulator::install_poll() {
+  budget_->limit = options_.max_settle_steps;
+  if (!options_.interrupted && budget_->limit == 0) return;
+  options_.static_options.interrupted = options_.explicit_options.interrupted = options_.flow_options.interrupted =
+      [interrupted = options_.interrupted, budget = budget_] {
+        if (interrupted && interrupted()) return true;
+        if (!budget->counting || budget->limit == 0 || ++budget->used <= budget->limit) return false;
+        budget->exceeded = true;
+        return true;
+      };
+}
+
 const SettleReport& Simulator::apply(const Action& action) { return apply_from(action, nullptr); }
 
 const SettleReport& Simulator::apply(const Action& action, const Eigen::Matrix3Xd& start) {
@@ -236,6 +248,7 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
   // parameters and takes a full settle (jammed-sweep of demo-bending under a
   // mass 0.01 % off: 7-8 Newton steps at each of its 12 jams).
   if (keeps_equilibrium_) start = nullptr;
+  *budget_ = StepBudget{budget_->limit, 0, true, false};
   try {
     if (start) {
       const Eigen::Matrix3Xd cold = state_.x;
@@ -248,12 +261,19 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
       if (!last_.converged) state_.x = cold;
     }
     if (!start || !last_.converged) settle();
+  } catch (const SettleInterrupted&) {
+    keeps_equilibrium_ = close_start_ = budget_->counting = false;
+    state_ = before;
+    if (budget_->exceeded)
+      throw NoEquilibrium("no static equilibrium found within " + std::to_string(budget_->limit) +
+                          " solver steps after " + action.describe());
+    throw;
   } catch (...) {
-    keeps_equilibrium_ = close_start_ = false;
+    keeps_equilibrium_ = close_start_ = budget_->counting = false;
     state_ = before;
     throw;
   }
-  keeps_equilibrium_ = false;
+  keeps_equilibrium_ = budget_->counting = false;
   if (!last_.converged) {
     // Where the settle stopped: a folded mesh is the usual reason (mesh_folds.h).
     const std::string folds = find_mesh_folds(m, state_.x).describe();

@@ -66,6 +66,10 @@ struct SimulatorOptions {
   // Polled while settling; true makes apply() throw SettleInterrupted with
   // the state as it was before the action. Overrides the solvers' own.
   std::function<bool()> interrupted;
+  // Solver steps (static and flow steps, explicit polls) one action's settle
+  // may take, all stages together; past them apply() throws NoEquilibrium.
+  // 0: no limit. Planners set it: a dead end must cost little.
+  int max_settle_steps = 0;
 };
 
 class Simulator {
@@ -118,7 +122,20 @@ class Simulator {
   bool folded_past_refusal(const Eigen::Matrix3Xd& x) const;
   const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
+  // The steps the current action's settle has polled (max_settle_steps);
+  // shared with the solvers' interrupted callbacks, so a moved simulator keeps it.
+  struct StepBudget {
+    int limit = 0;
+    int used = 0;
+    bool counting = false;
+    bool exceeded = false;
+  };
+  // Installs the callback the solvers poll every step: the caller's
+  // interrupted, then the step budget.
+  void install_poll();
+
   SimulatorOptions options_;
+  std::shared_ptr<StepBudget> budget_ = std::make_shared<StepBudget>();
   ForceModel model_;
   // The same effects on the coarser mesh (SimulatorOptions::coarse_start),
   // or null where the mesh is too small for it to pay.
