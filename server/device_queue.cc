@@ -134,7 +134,7 @@ v1::Job DeviceQueue::submit(const Caller& caller, const std::string& name, const
   }
   if (store_.queued_count() >= options_.max_queued)
     throw ServiceError(StatusCode::RESOURCE_EXHAUSTED,
-                       "device queue full: " + std::to_string(options_.max_queued) + " jobs waiting (--queue-size)");
+                       "device queue full: " + std::to_string(options_.max_queued) + " jobs waiting (--device-queue-size)");
   const std::int64_t id = store_.add(caller.name, name, plan);
   log_event("job_queued", {{"job", id}, {"owner", caller.name}, {"steps", plan.steps_size()}});
   changed();

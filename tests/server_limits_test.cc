@@ -112,6 +112,27 @@ TEST(ServerLimits, AJobNameIsBoundedAndHasNoControlCharacters) {
   EXPECT_EQ(response.job().name(), "ten bytes!");
 }
 
+TEST(ServerLimits, AFullDeviceQueueRefusesNamingItsFlagAndKeepsWhatWaits) {
+  ScratchDir dir;
+  server::ServerOptions o = options(1, 1, dir.path / "q.db");
+  o.device_queue_size = 1;
+  TestServer s(o);
+  s.link->hold();
+  v1::SubmitJobResponse running, waiting, refused_response;
+  ASSERT_TRUE(eventually([&] { return s.device->SubmitJob(call().get(), named_job("one"), &running).ok(); }));
+  ASSERT_TRUE(eventually([&] { return s.link->waiting() == 1; }));  // "one" runs, held at its step
+  ASSERT_TRUE(s.device->SubmitJob(call().get(), named_job("two"), &waiting).ok());
+  const grpc::Status refused = s.device->SubmitJob(call().get(), named_job("three"), &refused_response);
+  EXPECT_EQ(refused.error_code(), StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(refused.error_message().find("--device-queue-size"), std::string::npos) << refused.error_message();
+  v1::GetJobRequest get;
+  get.set_id(waiting.job().id());
+  v1::Job job;
+  ASSERT_TRUE(s.device->GetJob(call().get(), get, &job).ok());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_QUEUED);
+  s.link->release();
+}
+
 TEST(ServerLimits, QueueWatchersAreBounded) {
   ScratchDir dir;
   server::ServerOptions o = options(1, 1, dir.path / "q.db");
