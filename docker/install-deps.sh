@@ -12,6 +12,8 @@ packages=(
   python3 python3-grpcio python3-protobuf openssl
   libjs-three chromium chromium-driver python3-selenium
 )
+# Optional: clang and its libFuzzer/sanitizer runtimes for scripts/fuzz.sh (not used by CI).
+[ "${HJ_FUZZ_DEPS:-0}" = 1 ] && packages+=(clang libclang-rt-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -37,11 +37,12 @@ using Compute = std::function<Event(const std::function<bool()>& interrupted, co
 
 // Runs `compute` on the pool and relays its progress to `writer`, then its
 // result (also returned in `last`). Stops the work when the caller cancels
-// or its deadline passes (streamed_work.h).
+// or the deadline (the caller's, or --max-calibration-seconds) passes (streamed_work.h).
 template <class Event>
 grpc::Status run_streamed(grpc::ServerContext* context, grpc::ServerWriter<Event>* writer, WorkPool& pool,
-                          Compute<Event> compute, const std::string& what, Event& last) {
-  auto work = std::make_shared<StreamedWork<Event, Event>>(*context);
+                          const ServerLimits& limits, Compute<Event> compute, const std::string& what, Event& last) {
+  auto work =
+      std::make_shared<StreamedWork<Event, Event>>(*context, limits.max_calibration_time, "--max-calibration-seconds");
   auto task = [work, what, compute = std::move(compute)] {
     if (work->should_stop()) return work->finish(work->stopped_status(what));
     try {
@@ -81,7 +82,7 @@ grpc::Status run_streamed(grpc::ServerContext* context, grpc::ServerWriter<Event
 }
 
 // The replay options the request's options ask for (the commands'
-// replay_options): segments, threads (at most the server's cores).
+// replay_options): segments, threads (at most --calibration-threads and the server's cores).
 ReplayOptions replay_from(const v1::CalibrationOptions& o, const ServerLimits& limits) {
   ReplayOptions out;
   out.segments = o.segments() == 0 ? kDefaultSegments : o.segments();
@@ -90,7 +91,7 @@ ReplayOptions replay_from(const v1::CalibrationOptions& o, const ServerLimits& l
            std::to_string(limits.max_segments));
   if (o.threads() < 0) refuse("options.threads = " + std::to_string(o.threads()) + ": must be 0 (one per core) or more");
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  out.threads = std::min(o.threads(), cores);
+  out.threads = calibration_thread_count(o.threads(), limits, cores);
   return out;
 }
 
@@ -213,7 +214,7 @@ grpc::Status CalibrationServiceImpl::Compare(grpc::ServerContext* context, const
       return event;
     };
     v1::CompareEvent last;
-    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), "the comparison", last);
+    const grpc::Status status = run_streamed(context, writer, pool_, limits_, std::move(compute), "the comparison", last);
     if (!status.ok()) throw ServiceError(status.error_code(), status.error_message());
     rc.note("rmse_mm", last.result().rmse_mm());
   });
@@ -266,7 +267,7 @@ grpc::Status CalibrationServiceImpl::Fit(grpc::ServerContext* context, const v1:
       return event;
     };
     v1::FitEvent last;
-    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), "the fit", last);
+    const grpc::Status status = run_streamed(context, writer, pool_, limits_, std::move(compute), "the fit", last);
     if (!status.ok()) throw ServiceError(status.error_code(), status.error_message());
     rc.note("rmse_mm", last.result().rmse_mm());
   });
@@ -315,7 +316,7 @@ grpc::Status CalibrationServiceImpl::Diagnose(grpc::ServerContext* context, cons
       return event;
     };
     v1::DiagnoseEvent last;
-    const grpc::Status status = run_streamed(context, writer, pool_, std::move(compute), "the diagnosis", last);
+    const grpc::Status status = run_streamed(context, writer, pool_, limits_, std::move(compute), "the diagnosis", last);
     if (!status.ok()) throw ServiceError(status.error_code(), status.error_message());
     rc.note("verdict", list(last.result().verdict()));
   });

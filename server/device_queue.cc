@@ -24,6 +24,19 @@ int queue_position(const std::vector<StoredJob>& active, std::size_t index) {
   return int(index) + (active.front().state == v1::JOB_STATE_RUNNING ? 0 : 1);
 }
 
+// A job's name is a short label: bounded, and no control characters (it
+// goes into logs and tables).
+void check_job_name(const std::string& name, int max_bytes) {
+  if (int(name.size()) > max_bytes)
+    throw ServiceError(StatusCode::INVALID_ARGUMENT, "job name is " + std::to_string(name.size()) +
+                                                         " bytes, over the server's limit of " +
+                                                         std::to_string(max_bytes) + " (--max-job-name-bytes)");
+  for (std::size_t i = 0; i < name.size(); ++i)
+    if (static_cast<unsigned char>(name[i]) < 0x20 || name[i] == 0x7f)
+      throw ServiceError(StatusCode::INVALID_ARGUMENT,
+                         "job name has a control character at byte " + std::to_string(i));
+}
+
 }  // namespace
 
 DeviceQueue::DeviceQueue(JobStore& store, device::DeviceLink* link, DeviceQueueOptions options)
@@ -88,6 +101,7 @@ void DeviceQueue::require_device(const char* action) {
 }
 
 v1::Job DeviceQueue::submit(const Caller& caller, const std::string& name, const v1::Plan& plan) {
+  check_job_name(name, options_.limits.max_job_name_bytes);
   if (plan.steps_size() == 0) throw ServiceError(StatusCode::INVALID_ARGUMENT, "plan has no steps");
   if (plan.steps_size() > options_.limits.max_job_steps)
     throw ServiceError(StatusCode::INVALID_ARGUMENT, "plan has " + std::to_string(plan.steps_size()) +
@@ -120,7 +134,7 @@ v1::Job DeviceQueue::submit(const Caller& caller, const std::string& name, const
   }
   if (store_.queued_count() >= options_.max_queued)
     throw ServiceError(StatusCode::RESOURCE_EXHAUSTED,
-                       "device queue full: " + std::to_string(options_.max_queued) + " jobs waiting (--queue-size)");
+                       "device queue full: " + std::to_string(options_.max_queued) + " jobs waiting (--device-queue-size)");
   const std::int64_t id = store_.add(caller.name, name, plan);
   log_event("job_queued", {{"job", id}, {"owner", caller.name}, {"steps", plan.steps_size()}});
   changed();

@@ -1,10 +1,33 @@
 #include "device_service.h"
 
 #include "request_context.h"
+#include "service_error.h"
 
 namespace hj::server {
 
 namespace v1 = ::hapticjam::v1;
+
+namespace {
+
+// One of the bounded WatchQueue slots, held for the stream's life.
+class WatcherSlot {
+ public:
+  WatcherSlot(std::atomic<int>& count, int max) : count_(count) {
+    if (count_.fetch_add(1) >= max) {
+      count_.fetch_sub(1);
+      throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                         std::to_string(max) + " queue watchers already open, the server's limit (--max-watchers)");
+    }
+  }
+  ~WatcherSlot() { count_.fetch_sub(1); }
+  WatcherSlot(const WatcherSlot&) = delete;
+  WatcherSlot& operator=(const WatcherSlot&) = delete;
+
+ private:
+  std::atomic<int>& count_;
+};
+
+}  // namespace
 
 grpc::Status DeviceServiceImpl::SubmitJob(grpc::ServerContext* context, const v1::SubmitJobRequest* request,
                                           v1::SubmitJobResponse* response) {
@@ -21,6 +44,11 @@ grpc::Status DeviceServiceImpl::WatchQueue(grpc::ServerContext* context, const v
   RequestContext rc(context, "WatchQueue");
   return rc.finish([&] {
     rc.authorize(auth_, Role::kPreview, "WatchQueue");
+    if (request->recent_finished() < 0 || request->recent_finished() > limits_.max_recent_finished)
+      throw ServiceError(grpc::StatusCode::INVALID_ARGUMENT,
+                         "recent_finished = " + std::to_string(request->recent_finished()) + ": must be 0 .. " +
+                             std::to_string(limits_.max_recent_finished));
+    const WatcherSlot slot(watchers_, limits_.max_watchers);
     std::uint64_t seen = queue_.wait_for_change(0, std::chrono::milliseconds(0));
     if (!writer->Write(queue_.queue_state(request->recent_finished()))) return;
     // Every change, until the caller leaves or the server stops.

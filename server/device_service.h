@@ -1,6 +1,9 @@
 // DeviceService (proto/hapticjam/v1/device_service.proto): authorises each
-// call by role and hands it to the DeviceQueue.
+// call by role and hands it to the DeviceQueue. WatchQueue streams are
+// bounded (ServerLimits::max_watchers): each holds a server thread.
 #pragma once
+
+#include <atomic>
 
 #include "auth.h"
 #include "device_queue.h"
@@ -10,7 +13,8 @@ namespace hj::server {
 
 class DeviceServiceImpl final : public hapticjam::v1::DeviceService::Service {
  public:
-  DeviceServiceImpl(const Authenticator& auth, DeviceQueue& queue) : auth_(auth), queue_(queue) {}
+  DeviceServiceImpl(const Authenticator& auth, DeviceQueue& queue, const ServerLimits& limits)
+      : auth_(auth), queue_(queue), limits_(limits) {}
 
   grpc::Status SubmitJob(grpc::ServerContext* context, const hapticjam::v1::SubmitJobRequest* request,
                          hapticjam::v1::SubmitJobResponse* response) override;
@@ -30,6 +34,8 @@ class DeviceServiceImpl final : public hapticjam::v1::DeviceService::Service {
  private:
   const Authenticator& auth_;
   DeviceQueue& queue_;
+  const ServerLimits& limits_;
+  std::atomic<int> watchers_{0};
 };
 
 }  // namespace hj::server

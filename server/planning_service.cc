@@ -67,7 +67,7 @@ grpc::Status PlanningServiceImpl::plan_or_cached(grpc::ServerContext* context, c
     return grpc::Status::OK;
   }
 
-  auto work = std::make_shared<Work>(*context);
+  auto work = std::make_shared<Work>(*context, limits_.max_plan_time, "--max-plan-seconds");
   const bool streaming = writer != nullptr;
   auto task = [work, request, snapshots, streaming, key, &maps = maps_, &limits = limits_, &cache = cache_] {
     if (work->should_stop()) return work->finish({grpc::StatusCode::CANCELLED, "cancelled before it started"});

@@ -3,12 +3,14 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
 #include <grpcpp/security/server_credentials.h>
+#include <grpcpp/resource_quota.h>
 #include <grpcpp/server_builder.h>
 
 #include <fstream>
 #include <sstream>
 
 #include "json_log.h"
+#include "token_gate.h"
 
 namespace hj::server {
 
@@ -26,11 +28,30 @@ std::string read_file(const std::string& path, const char* flag) {
   return s.str();
 }
 
-std::shared_ptr<grpc::ServerCredentials> credentials(const ServerOptions& options) {
+// With TLS and auth, the token is checked from the headers, before the
+// message is parsed (token_gate.h).
+std::shared_ptr<grpc::ServerCredentials> credentials(const ServerOptions& options, const Authenticator& auth) {
   if (options.tls_cert.empty()) return grpc::InsecureServerCredentials();
   grpc::SslServerCredentialsOptions ssl;
   ssl.pem_key_cert_pairs.push_back({read_file(options.tls_key, "--tls-key"), read_file(options.tls_cert, "--tls-cert")});
-  return grpc::SslServerCredentials(ssl);
+  auto out = grpc::SslServerCredentials(ssl);
+  if (auth.enabled()) out->SetAuthMetadataProcessor(std::make_shared<TokenGate>(auth));
+  return out;
+}
+
+// The transport's bounds (ServerLimits): threads, streams per connection, keepalive.
+void apply_transport_limits(const ServerLimits& limits, grpc::ServerBuilder& builder) {
+  grpc::ResourceQuota quota("hapticjam-server");
+  quota.SetMaxThreads(limits.max_threads);
+  builder.SetResourceQuota(quota);
+  builder.SetMaxReceiveMessageSize(limits.max_message_bytes);
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, limits.max_concurrent_streams);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, int(limits.keepalive_time.count()));
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, int(limits.keepalive_timeout.count()));
+  // Clients may ping (also between calls), but no more often than every 10 s.
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, 10'000);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PING_STRIKES, 2);
 }
 
 }  // namespace
@@ -53,14 +74,14 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   queue_ = std::make_unique<DeviceQueue>(*store_, link_.get(), device_options);
   pool_ = std::make_unique<WorkPool>(options_.worker_count(), options_.queue_size);
   planning_ = std::make_unique<PlanningServiceImpl>(auth_, maps_, options_.limits, *pool_, *cache_);
-  device_ = std::make_unique<DeviceServiceImpl>(auth_, *queue_);
+  device_ = std::make_unique<DeviceServiceImpl>(auth_, *queue_, options_.limits);
   calibration_ = std::make_unique<CalibrationServiceImpl>(auth_, options_.limits, *pool_);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(options_.listen, credentials(options_), &port_);
-  builder.SetMaxReceiveMessageSize(options_.limits.max_message_bytes);
+  builder.AddListeningPort(options_.listen, credentials(options_, auth_), &port_);
+  apply_transport_limits(options_.limits, builder);
   builder.RegisterService(planning_.get());
   builder.RegisterService(device_.get());
   builder.RegisterService(calibration_.get());

@@ -1,5 +1,6 @@
 #include "server_options.h"
 
+#include <chrono>
 #include <stdexcept>
 #include <thread>
 
@@ -10,7 +11,7 @@ const char* const kServerUsage =
     "                        [--auth FILE] [--db FILE] [--tls-cert F --tls-key F] [--trusted-network]\n"
     "                        [--map NAME=FILE ...] [--queue-size N] [--device-queue-size N]\n"
     "                        [--cache-size N] [--max-message-mib N] [--http HOST:PORT]\n"
-    "                        [--keep-jobs N] [--keep-days N]\n"
+    "                        [--keep-jobs N] [--keep-days N] [per-call and transport limits]\n"
     "The hapticjam gRPC server (proto/hapticjam/v1): planning on a pool of simulator\n"
     "workers, and a persistent queue of jobs for the attached array.\n"
     "  --listen HOST:PORT      address to serve on; port 0 picks a free port (printed).\n"
@@ -39,6 +40,17 @@ const char* const kServerUsage =
     "                          (default 1000, 0 = no bound)\n"
     "  --keep-days N           finished device jobs older than N days are deleted (default 30,\n"
     "                          0 = no bound)\n"
+    "Per-call and transport limits (server/README.md, docs/safety.md):\n"
+    "  --max-plan-seconds N    longest Plan or Preview, whatever the caller's deadline\n"
+    "                          (default 1800, 0 = no bound); past it DEADLINE_EXCEEDED\n"
+    "  --max-calibration-seconds N  longest Compare, Fit or Diagnose (default 21600, 0 = no bound)\n"
+    "  --calibration-threads N cores one Compare, Fit or Diagnose may use (default 0 = all)\n"
+    "  --max-job-name-bytes N  longest device job name (default 200)\n"
+    "  --max-watchers N        WatchQueue streams open at once (default 32)\n"
+    "  --max-threads N         threads gRPC may use for calls (resource quota, default 256)\n"
+    "  --max-streams N         concurrent calls on one connection (default 100)\n"
+    "  --keepalive-seconds N   ping an idle connection this often, drop it after 20 s\n"
+    "                          without an answer (default 60)\n"
     "  --help                  this text\n"
     "Logs: one JSON object per line on stderr. SIGINT/SIGTERM shut down cleanly.\n";
 
@@ -56,6 +68,21 @@ int parse_count(const std::string& flag, const std::string& text, int lo, int hi
     throw std::invalid_argument(flag + " needs a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
                                 "], got \"" + text + "\"");
   return int(value);
+}
+
+// The per-call and transport limits' flags; false if `flag` is none of them.
+bool parse_limit_flag(const std::string& flag, const std::string& v, ServerLimits& limits) {
+  using std::chrono::seconds;
+  if (flag == "--max-plan-seconds") limits.max_plan_time = seconds(parse_count(flag, v, 0, 1'000'000));
+  else if (flag == "--max-calibration-seconds") limits.max_calibration_time = seconds(parse_count(flag, v, 0, 10'000'000));
+  else if (flag == "--calibration-threads") limits.calibration_threads = parse_count(flag, v, 0, 1024);
+  else if (flag == "--max-job-name-bytes") limits.max_job_name_bytes = parse_count(flag, v, 1, 65'536);
+  else if (flag == "--max-watchers") limits.max_watchers = parse_count(flag, v, 1, 10'000);
+  else if (flag == "--max-threads") limits.max_threads = parse_count(flag, v, 8, 100'000);
+  else if (flag == "--max-streams") limits.max_concurrent_streams = parse_count(flag, v, 1, 100'000);
+  else if (flag == "--keepalive-seconds") limits.keepalive_time = seconds(parse_count(flag, v, 10, 86'400));
+  else return false;
+  return true;
 }
 
 }  // namespace
@@ -101,7 +128,7 @@ ServerOptions parse_server_args(const std::vector<std::string>& args, bool* help
     else if (a == "--max-message-mib") out.limits.max_message_bytes = parse_count(a, v, 1, 1024) << 20;
     else if (a == "--keep-jobs") out.keep_jobs = parse_count(a, v, 0, 100'000'000);
     else if (a == "--keep-days") out.keep_days = parse_count(a, v, 0, 100'000);
-    else throw std::invalid_argument("unknown option " + a + " (see --help)");
+    else if (!parse_limit_flag(a, v, out.limits)) throw std::invalid_argument("unknown option " + a + " (see --help)");
   }
   out.validate();
   return out;

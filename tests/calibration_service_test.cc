@@ -3,8 +3,9 @@
 // streamed compare, fit and diagnosis (with its report.html) equal the
 // library's own on the same data, progress comes before the result and does
 // not go back within a stage, a malformed upload is refused naming the file
-// and key, cancelling or a passed deadline frees the worker of a fit or
-// diagnosis that would take minutes, and a previewer may compare but not fit.
+// and key, cancelling or a passed deadline (the caller's or the server's
+// --max-calibration-seconds) frees the worker of a fit or diagnosis that
+// would take minutes, and a previewer may compare but not fit.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -425,6 +426,26 @@ TEST_F(CalibrationService, ADeadlineStopsADiagnosisAndFreesTheWorker) {
   auto next = c.stub->Compare(next_context.get(), compare_request(dataset_dir()));
   const grpc::Status status = read_all(*next).status;
   EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+TEST_F(CalibrationService, TheServersLimitStopsADiagnosisWhateverTheCallersDeadline) {
+  ScratchDir dir;
+  server::ServerOptions o = options(1, 1, dir.path / "q.db");
+  o.limits.max_calibration_time = std::chrono::seconds(2);
+  TestServer s(o, false);
+  Client c(s);
+  v1::DiagnoseRequest request;
+  *request.mutable_dataset() = upload(kBending);
+  request.set_no_screening(true);
+  auto context = call("", 60);
+  auto reader = c.stub->Diagnose(context.get(), request);
+  const grpc::Status status = read_all(*reader).status;
+  EXPECT_EQ(status.error_code(), StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_NE(status.error_message().find("--max-calibration-seconds"), std::string::npos) << status.error_message();
+  auto next_context = call("", 60);
+  auto next = c.stub->Compare(next_context.get(), compare_request(dataset_dir()));
+  const grpc::Status next_status = read_all(*next).status;
+  EXPECT_TRUE(next_status.ok()) << next_status.error_message();
 }
 
 TEST_F(CalibrationService, APreviewerMayCompareButNotFitOrDiagnose) {

@@ -2,6 +2,7 @@
 #include "shapes/mesh_importer.h"
 
 #include <assimp/DefaultIOSystem.h>
+#include <assimp/IOStream.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <string>
 #include <system_error>
 
@@ -54,6 +56,27 @@ long triangles_after_processing(const aiScene& scene, long limit) {
   return total;
 }
 
+// A stream that tells `open` when it is deleted, however Assimp deletes it
+// (through Close, or directly).
+class TrackedStream final : public Assimp::IOStream {
+ public:
+  TrackedStream(Assimp::IOStream* file, std::set<Assimp::IOStream*>& open) : file_(file), open_(open) {}
+  ~TrackedStream() override {
+    open_.erase(this);
+    delete file_;
+  }
+  size_t Read(void* buffer, size_t size, size_t count) override { return file_->Read(buffer, size, count); }
+  size_t Write(const void* buffer, size_t size, size_t count) override { return file_->Write(buffer, size, count); }
+  aiReturn Seek(size_t offset, aiOrigin origin) override { return file_->Seek(offset, origin); }
+  size_t Tell() const override { return file_->Tell(); }
+  size_t FileSize() const override { return file_->FileSize(); }
+  void Flush() override { file_->Flush(); }
+
+ private:
+  Assimp::IOStream* file_;
+  std::set<Assimp::IOStream*>& open_;
+};
+
 // Assimp's file access, confined to the folder of the mesh being imported:
 // a file the mesh names (a glTF buffer or image, an OBJ material library) is
 // read only from inside that folder, never through "..", an absolute path
@@ -62,6 +85,12 @@ class ConfinedIOSystem final : public Assimp::DefaultIOSystem {
  public:
   explicit ConfinedIOSystem(const std::filesystem::path& file)
       : folder_(std::filesystem::weakly_canonical(std::filesystem::absolute(file).parent_path())) {}
+  // Assimp 5.2's glTF reader does not close a buffer it fails to read (a
+  // file descriptor per malformed upload): what it left open is closed here.
+  ~ConfinedIOSystem() override {
+    const std::set<Assimp::IOStream*> left = open_;
+    for (Assimp::IOStream* stream : left) delete stream;
+  }
 
   bool Exists(const char* path) const override {
     if (!inside(path)) return refuse(path);
@@ -69,7 +98,11 @@ class ConfinedIOSystem final : public Assimp::DefaultIOSystem {
   }
   Assimp::IOStream* Open(const char* path, const char* mode) override {
     if (!inside(path) || std::string(mode).find_first_of("wa+") != std::string::npos) return refuse(path), nullptr;
-    return DefaultIOSystem::Open(path, mode);
+    Assimp::IOStream* file = DefaultIOSystem::Open(path, mode);
+    if (!file) return nullptr;
+    Assimp::IOStream* stream = new TrackedStream(file, open_);
+    open_.insert(stream);
+    return stream;
   }
   // The first path refused, "" if none.
   const std::string& refused() const { return refused_; }
@@ -91,6 +124,7 @@ class ConfinedIOSystem final : public Assimp::DefaultIOSystem {
 
   std::filesystem::path folder_;
   mutable std::string refused_;
+  std::set<Assimp::IOStream*> open_;
 };
 
 class MeshImporter final : public GoalImporter {

@@ -46,7 +46,7 @@ EffectParameterValues resolve_parameters(const EffectInfo& info, const EffectPar
   for (const auto& spec : info.parameters) out[spec.name] = spec.default_value;
   for (const auto& [name, value] : given) {
     const auto spec = std::find_if(info.parameters.begin(), info.parameters.end(),
-                                   [&](const ParameterSpec& s) { return s.name == name; });
+                                   [&name = name](const ParameterSpec& s) { return s.name == name; });
     if (spec == info.parameters.end()) {
       std::string known;
       for (const auto& s : info.parameters) known += (known.empty() ? "" : ", ") + s.name;

@@ -1,0 +1,58 @@
+// A self-signed certificate for localhost and 127.0.0.1 (valid for a century)
+// and its key, for tests that serve TLS. Test material only: never deploy it.
+#pragma once
+
+namespace hj::testing_support {
+
+inline constexpr const char* kTestTlsCert = R"(-----BEGIN CERTIFICATE-----
+MIIDJzCCAg+gAwIBAgIUHs1ORh4C769LtujfPqgRQErVRGcwDQYJKoZIhvcNAQEL
+BQAwFDESMBAGA1UEAwwJbG9jYWxob3N0MCAXDTI2MTIwMjAwMzA0M1oYDzIxMjYx
+MTA4MDAzMDQzWjAUMRIwEAYDVQQDDAlsb2NhbGhvc3QwggEiMA0GCSqGSIb3DQEB
+AQUAA4IBDwAwggEKAoIBAQDAHPxixKs363eiFKRHo3z+rzjyhp6Igg1fuqQcAazF
+T4j9XeKcBX/iIsDD6tJ7BHexsu/mR/qPF16aHNFyTRyuKrK4xSY0rJXnFIKgGgtS
+vu51yqmrG2icW6eakKun5fkNP2Ig0baGPoc7vsF13AlpgmxfgzIMlMDpjbjMCcj8
+2YnBElyiEqFjSlNmQe8AfccKu/4fs/Phs1dF5567Iug7s/y05gXZqOgmbUrXLnCc
+hJVtsBoAtYrTU1WtBPUYQ3ezwH5idPHNQUI/SMw3bmwRHrnQtVOnCzFiGyws3ayn
+XN19XxQ4DFPl1e4c/BSuAN95UTsO2UCP3qqE7bfJMDZjAgMBAAGjbzBtMB0GA1Ud
+DgQWBBRlumoOUMlgLelinNeJ9A/dTDhb3zAfBgNVHSMEGDAWgBRlumoOUMlgLeli
+nNeJ9A/dTDhb3zAPBgNVHRMBAf8EBTADAQH/MBoGA1UdEQQTMBGCCWxvY2FsaG9z
+dIcEfwAAATANBgkqhkiG9w0BAQsFAAOCAQEAM83YUzcN8PUmAKY+yvkVCreF1T4o
+7czq87Stgb94/VL/bW2jM0wZw4aIaBzMjhUCa6e+3ysHaZeKi81OYPewSpWFfTX9
+ZVLLXGj/gnXPy6d1NxwFSleZNEwRugotKXq0/Ccrq/2C+hpUo1Qd+lGUhbx8qBvs
+AGvl7e9tTyqyPsrciOybF4FWzcqudmADiVfhl66uyQTa8nbsd0q9sUil3bZ507p1
+syyayrzmigZvXj6p1243br+UTL66eY6wTNpQnBsSnkQlIp3twkaeMhoBI/21q7A4
+G5kLsIxXf63diy4jt/DLTjIMhHB4DSpY86KwBpaAcQ7lgIa9TdgtxfvC9Q==
+-----END CERTIFICATE-----
+)";
+
+inline constexpr const char* kTestTlsKey = R"(-----BEGIN PRIVATE KEY-----
+MIIEvQIBADANBgkqhkiG9w0BAQEFAASCBKcwggSjAgEAAoIBAQDAHPxixKs363ei
+FKRHo3z+rzjyhp6Igg1fuqQcAazFT4j9XeKcBX/iIsDD6tJ7BHexsu/mR/qPF16a
+HNFyTRyuKrK4xSY0rJXnFIKgGgtSvu51yqmrG2icW6eakKun5fkNP2Ig0baGPoc7
+vsF13AlpgmxfgzIMlMDpjbjMCcj82YnBElyiEqFjSlNmQe8AfccKu/4fs/Phs1dF
+5567Iug7s/y05gXZqOgmbUrXLnCchJVtsBoAtYrTU1WtBPUYQ3ezwH5idPHNQUI/
+SMw3bmwRHrnQtVOnCzFiGyws3aynXN19XxQ4DFPl1e4c/BSuAN95UTsO2UCP3qqE
+7bfJMDZjAgMBAAECggEAHriD44dvmdGdn92NJ6eNJWz/vkiosUuat+QwugnKhwLg
+9SM+SZTXjmHgUXQLlIByY4gptLlt59Pk3OAe3hhWrcNGMSXVpjazAfDVsqR3ixPd
+LhjqaOJJKDe/5Yec64xq9yNbncPrXCxDk9o9NYuqNaUVj3B7YGepMa/oDTjDWytn
+K1OpdsEP/2b1C2p/ig+6pk9YvhA99+1ChBERzxJKfDNLCa5lBaw4zbJ5fn6GcV9Y
+2f7YP3DJOBl/XzfP4RhA1WEr39x7JFCypU95evbEg4B19iQ+lejOAVcHc8/zu+cC
+isff8dLfWknbHLlhpp+t3zPeoHF4qKvZnFXOV6GcgQKBgQDvFVY6N2cilSwVVt3/
+IXrkPrWmalucXXKJhkySFBuvp8D0qa4UjLJ7oN7fQD2/d8di99G4Q6nTgTUHA+7P
+Yc2cvg9zVbIcBmS/eI5rxdjMtuTogdad4OSrFr9+gl6cyo7mJ/Ew2NIg1vaY+ZWF
+inl19g/orGEyn6DTWLhLqGQvlwKBgQDNtNm4orGVdmZwa6PEYGWnPefhWOMv155Z
+ovydpomHLG5cJfS/9Jo5FFQCbhjT7kVZtP8oU7BwXJrNeHJoVCk0IQabPpWepiHp
+B449y3i2jU3o/O9mk404RPtRKbqtFNKxuHK1BBfG3WbSb+U7G63+1z4/hNxHJOUQ
+bRoxkJQJFQKBgQC7YRmnnuxyKj/WqbJr1y2d3Zg4yXrrXkH6jwtMIf5g+TU9jA8n
+g+4O/tIuXwcGHTZj1p7DsCRV5BpPWUG9v4WKp1sspalmVYx4lF/rD7EPIPjfUYOH
+UU9m1/lViY/lisvcjsl14zktC81Rr6sEcrcnQKbPUOsM5hcCDbLDeUKsGQKBgDyR
+sL3l4cYxi640c48iFyxsVPeMdbCjm3OnQxykacBMe95UKsHOow6FhssEYfkdInxs
+h+j242/iRI6VlZJUnaFEzC4v+lwxbLCx0dcuL0gJSVR+DXu1nJJh9WILmHTYOcWs
+mtHj96BNlrYFzohd+Ridhi2r0DR+j5gLl/faK0yVAoGARZhTkMLFEYk7PkIflV4M
+clijcEhurtDYwaCu6I5L3lQTU/vluE2JYzA4Agk5oVm2+mPz0gcRDalDMqkA9pG8
+RcvIUYY3KYhUgaEFpborf59igP5C4G1qO/DKVLEKmpPJieUWjg2emqjfgXw2mNsw
+AFyx+mzjScER5vqfU10wHgQ=
+-----END PRIVATE KEY-----
+)";
+
+}  // namespace hj::testing_support
