@@ -178,6 +178,8 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
   for (const auto& c : d.ranking) ranking.push_back(candidate_json(c));
   for (const auto& c : d.later_rounds) later.push_back(candidate_json(c));
   for (auto [r, c] : d.pattern.worst_cells) worst.push_back({r, c});
+  nlohmann::json final_worst = nlohmann::json::array();
+  for (auto [r, c] : d.final_pattern.worst_cells) final_worst.push_back({r, c});
   nlohmann::json ladder = nlohmann::json::array();
   for (const auto& step : d.ladder)
     ladder.push_back({{"model", step.label}, {"rmse_mm", step.rmse_mm}, {"heldout_rmse_mm", step.heldout_rmse_mm}});
@@ -197,6 +199,22 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
           {"notes", d.notes},
           {"ladder", ladder},
           {"noise_floor_mm", d.noise_floor_mm},
+          {"explained", d.goodness.explained},
+          {"goodness_of_fit",
+           {{"rmse_mm", d.goodness.rmse_mm},
+            {"noise_floor_mm", d.goodness.noise_floor_mm},
+            {"chi2", d.goodness.chi2},
+            {"dof", d.goodness.dof},
+            {"p_value", d.goodness.p_value},
+            {"systematic_mm", d.goodness.systematic_mm},
+            {"explained", d.goodness.explained}}},
+          {"chi2", d.goodness.chi2},
+          {"dof", d.goodness.dof},
+          {"p_value", d.goodness.p_value},
+          {"best_rmse_mm", d.best_rmse_mm},
+          {"best_effects", d.best_effects},
+          {"final_worst_cells", final_worst},
+          {"final_findings", d.final_pattern.findings},
           {"final_params", model_params_json(d.final_params)}};
 }
 

@@ -438,6 +438,25 @@ std::vector<std::string> effects_for_next_round(const std::vector<CandidateFit>&
   return next;
 }
 
+// The final model against the sensor's noise (goodness_of_fit.h), where its
+// residual concentrates, and the lowest RMSE any refitted candidate reached.
+void judge_final_model(const Dataset& dataset, const DiagnoseOptions& options, const LeastSquaresResult& final_fit,
+                       Diagnosis& out) {
+  out.goodness = goodness_of_fit(final_fit, out.noise_floor_mm, options.goodness);
+  out.final_pattern = out.verdict.empty()
+                          ? out.pattern
+                          : describe_residuals(dataset, evaluate_dataset(dataset, final_fit.params,
+                                                                         options.fit.least_squares.replay));
+  out.best_rmse_mm = final_fit.rmse_mm;
+  out.best_effects = out.verdict;
+  for (const auto* record : {&out.ranking, &out.later_rounds})
+    for (const CandidateFit& c : *record)
+      if (!c.screened_out && std::isfinite(c.fit.rmse_mm) && c.fit.rmse_mm < out.best_rmse_mm) {
+        out.best_rmse_mm = c.fit.rmse_mm;
+        out.best_effects = c.effects;
+      }
+}
+
 }  // namespace
 
 Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const DiagnoseOptions& options,
@@ -468,6 +487,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   }
   out.verdict = s.chosen;
   out.final_params = s.current.params;
+  judge_final_model(dataset, options, s.current, out);
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include "calib/cross_validation.h"
 #include "calib/effect_scan.h"
 #include "calib/fit_model.h"
+#include "calib/goodness_of_fit.h"
 #include "calib/residual_pattern.h"
 #include "calib/screening.h"
 
@@ -56,6 +57,8 @@ struct DiagnoseOptions {
   // that passes the screening.
   double refit_cutoff = 2.0;
   EffectScanOptions scan_options;
+  // Whether the final model explains the data (goodness_of_fit.h).
+  GoodnessOfFitOptions goodness;
   // A candidate whose predicted delta BIC passes but whose predicted
   // held-out gain does not is screened out only if replaying the held-out
   // sessions at the folds' predicted parameters (one replay of the
@@ -105,6 +108,15 @@ struct Diagnosis {
   std::vector<std::string> skipped;   // candidates that failed to fit, with why
   std::vector<std::string> notes;     // e.g. a model whose fit did not converge
   double noise_floor_mm = 0.0;
+  // The final model's residuals against the sensor's noise model: "no
+  // effect is needed" only where the baseline passes it.
+  GoodnessOfFit goodness;
+  // Where the final model's residual concentrates (the baseline's pattern
+  // when nothing was chosen).
+  ResidualPattern final_pattern;
+  // The lowest in-sample RMSE any refitted model reached, and its effects.
+  double best_rmse_mm = 0.0;
+  std::vector<std::string> best_effects;
 };
 
 // BIC of a least-squares fit with Gaussian residuals: n ln(SSR / n) + p ln n.
