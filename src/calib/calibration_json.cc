@@ -177,7 +177,9 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
   nlohmann::json ranking = nlohmann::json::array(), later = nlohmann::json::array(), worst = nlohmann::json::array();
   for (const auto& c : d.ranking) ranking.push_back(candidate_json(c));
   for (const auto& c : d.later_rounds) later.push_back(candidate_json(c));
-  for (auto [r, c] : d.pattern.worst_cells) worst.push_back({r, c});
+  for (auto [r, c] : d.worst_cells) worst.push_back({r, c});
+  nlohmann::json baseline_worst = nlohmann::json::array();
+  for (auto [r, c] : d.pattern.worst_cells) baseline_worst.push_back({r, c});
   nlohmann::json final_worst = nlohmann::json::array();
   for (auto [r, c] : d.final_pattern.worst_cells) final_worst.push_back({r, c});
   nlohmann::json ladder = nlohmann::json::array();
@@ -194,6 +196,7 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
           {"later_rounds", later},
           {"verdict", d.verdict},
           {"worst_cells", worst},
+          {"baseline_worst_cells", baseline_worst},
           {"findings", d.pattern.findings},
           {"skipped", d.skipped},
           {"notes", d.notes},

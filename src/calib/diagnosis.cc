@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "calib/candidate_screening.h"
+#include "calib/cell_search.h"
 #include "calib/gain_by_capture.h"
 #include "calib/like_with_like.h"
 
@@ -275,12 +276,20 @@ CandidateFit scanned_candidate(const Selection& s, const std::string& effect) {
   const auto parameters = fit_parameters(c.effects);
   if (s.progress) s.progress("scan " + effect, 0, 1, "");
   try {
-    EffectScan scan = scan_effect_start(s.dataset, with_effects(s.current.params, c.effects), parameters, effect,
-                                        s.options.fit.least_squares.replay, s.options.scan_options);
+    ModelParams start = with_effects(s.current.params, c.effects);
+    if (is_cell_effect(effect)) {
+      // Which cell: a search no local fit can make (cell_search.h).
+      CellSearch cell = search_cells(s.dataset, start, parameters, effect, s.current, s.options.fit.least_squares.replay);
+      start = cell.best;
+      c.scanned_start = start;
+      c.scan_note = cell.note;
+    }
+    EffectScan scan = scan_effect_start(s.dataset, start, parameters, effect, s.options.fit.least_squares.replay,
+                                        s.options.scan_options);
     c.scan_rmse_mm = std::sqrt(scan.best_sum_sq_mm2 / std::max(s.current.residual_count, 1L));
     if (scan.moved) {
       c.scanned_start = std::move(scan.best);
-      c.scan_note = scan.note;
+      c.scan_note += (c.scan_note.empty() ? "" : "; ") + scan.note;
     }
   } catch (const SettleInterrupted&) {
     throw;  // the caller stopped the work: not a failed replay
@@ -447,6 +456,15 @@ void judge_final_model(const Dataset& dataset, const DiagnoseOptions& options, c
                           ? out.pattern
                           : describe_residuals(dataset, evaluate_dataset(dataset, final_fit.params,
                                                                          options.fit.least_squares.replay));
+  for (const auto& e : out.verdict)
+    if (is_cell_effect(e)) {
+      const auto& v = out.final_params.effect_parameters.at(e);
+      out.worst_cells.push_back({static_cast<int>(std::lround(v.at("row"))), static_cast<int>(std::lround(v.at("col")))});
+    }
+  for (const auto& cell : out.pattern.worst_cells)
+    if (out.worst_cells.size() < out.pattern.worst_cells.size() &&
+        std::find(out.worst_cells.begin(), out.worst_cells.end(), cell) == out.worst_cells.end())
+      out.worst_cells.push_back(cell);
   out.best_rmse_mm = final_fit.rmse_mm;
   out.best_effects = out.verdict;
   for (const auto* record : {&out.ranking, &out.later_rounds})

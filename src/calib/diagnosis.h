@@ -114,6 +114,9 @@ struct Diagnosis {
   // Where the final model's residual concentrates (the baseline's pattern
   // when nothing was chosen).
   ResidualPattern final_pattern;
+  // Where the missing effect is, worst first: the cell of a chosen local
+  // effect (cell_defect), then the baseline residual's worst cells.
+  std::vector<std::pair<int, int>> worst_cells;
   // The lowest in-sample RMSE any refitted model reached, and its effects.
   double best_rmse_mm = 0.0;
   std::vector<std::string> best_effects;
