@@ -36,7 +36,9 @@ nlohmann::json time_split(const nlohmann::json& timing) {
   auto part_of = [](const std::string& stage) -> std::string {
     if (stage.rfind("recheck ", 0) == 0 || stage.find("(refitted from ") != std::string::npos) return "rechecks";
     if (stage.rfind("screening ", 0) == 0 || stage.rfind("scan ", 0) == 0) return "screening";
-    if (stage.rfind("candidate ", 0) == 0 || stage.rfind("converging baseline + ", 0) == 0) return "refits";
+    if (stage.rfind("candidate ", 0) == 0 || stage.rfind("multi-start ", 0) == 0 ||
+        stage.rfind("converging baseline + ", 0) == 0)
+      return "refits";
     if (stage == "cross-validation" || stage == "residual pattern") return stage;
     return "baseline fit";
   };

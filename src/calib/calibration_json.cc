@@ -21,6 +21,12 @@ nlohmann::json candidate_json(const CandidateFit& c) {
   if (c.screened_out) j["screening"] = c.screening_note;
   if (!c.scan_note.empty()) j["scan"] = c.scan_note;
   if (!c.recheck_note.empty()) j["recheck"] = c.recheck_note;
+  if (!c.starts_tried.empty()) {
+    nlohmann::json starts = nlohmann::json::array();
+    for (const auto& t : c.starts_tried)
+      starts.push_back({{"start", t.value}, {"fitted", t.fitted}, {"rmse_mm", t.rmse_mm}});
+    j["starts"] = {{"parameter", c.multi_start_parameter}, {"tried", starts}};
+  }
   if (c.screened)
     j["predicted"] = {{"rmse_mm", c.predicted_rmse_mm},
                       {"heldout_rmse_mm", c.predicted_heldout_rmse_mm},

@@ -320,6 +320,38 @@ void scan_and_screen(const Selection& s, const std::vector<std::string>& remaini
   }
 }
 
+// Short joint fits from values spanning the new parameter's range and from
+// the scan's start (multi_start.h); the refit starts from the best.
+void start_from_best_of_range(const Selection& s, CandidateFit& c) {
+  if (s.options.multi_start.starts < 1 || !wants_multi_start(c.added)) return;
+  const auto parameters = fit_parameters(c.effects);
+  const ModelParams scanned = c.scanned_start ? *c.scanned_start : with_effects(s.current.params, c.effects);
+  if (s.progress) s.progress("multi-start " + c.added, 0, 1, "");
+  MultiStart range = multi_start(s.dataset, scanned, parameters, c.added, s.options.fit.least_squares,
+                                 s.options.multi_start);
+  // The scan's start on the same footing: its own short fit.
+  LeastSquaresOptions short_fit = s.options.fit.least_squares;
+  short_fit.max_iterations = s.options.multi_start.iterations;
+  c.multi_start_parameter = range.parameter;
+  c.starts_tried = range.tried;
+  try {
+    const LeastSquaresResult from_scan = fit_least_squares(s.dataset, scanned, parameters, short_fit);
+    for (const auto& p : parameters)
+      if (!p.surface && p.effect == c.added)
+        c.starts_tried.push_back({parameter_value(scanned, p), from_scan.rmse_mm, parameter_value(from_scan.params, p)});
+    if (from_scan.sum_sq_mm2 <= range.best_sum_sq_mm2) {
+      c.scanned_start = from_scan.params;
+      range.found = false;
+    }
+  } catch (const SettleInterrupted&) {
+    throw;
+  } catch (const std::exception&) {
+    // The scan's start does not replay: the range's best stands.
+  }
+  if (range.found) c.scanned_start = range.best;
+  if (s.progress) s.progress("multi-start " + c.added, 1, 1, "");
+}
+
 // Refits one candidate from the current optimum, cross-validates it and
 // judges it; false (and said so in out.skipped) if the model cannot replay it.
 bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
@@ -329,8 +361,9 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
   const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
   const DiagnoseProgress& progress = s.progress;
   // Warm start: the current model's optimum, the new effect where the scan
-  // found it best.
+  // found it best, or where the best short fit over its range ended.
   try {
+    start_from_best_of_range(s, c);
     c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options,
                           [&](int iteration, int max_iterations, double rmse) {
                             if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));

@@ -14,6 +14,7 @@
 #include "calib/effect_scan.h"
 #include "calib/fit_model.h"
 #include "calib/goodness_of_fit.h"
+#include "calib/multi_start.h"
 #include "calib/residual_pattern.h"
 #include "calib/screening.h"
 
@@ -57,6 +58,10 @@ struct DiagnoseOptions {
   // that passes the screening.
   double refit_cutoff = 2.0;
   EffectScanOptions scan_options;
+  // A refitted candidate with one parameter starts from the best of short
+  // joint fits from values spanning that parameter's range and from the
+  // scan's start (multi_start.h). starts = 0: from the scan's start only.
+  MultiStartOptions multi_start;
   // Whether the final model explains the data (goodness_of_fit.h).
   GoodnessOfFitOptions goodness;
   // A candidate whose predicted delta BIC passes but whose predicted
@@ -86,6 +91,10 @@ struct CandidateFit {
   // candidate's figures: refitted, or no longer significant.
   std::string recheck_note;
   std::optional<ModelParams> scanned_start;
+  // The multi-start's short fits (multi_start.h), the scan's start last;
+  // empty if it did not run.
+  std::string multi_start_parameter;
+  std::vector<StartTried> starts_tried;
   // The RMSE at the scan's best point (or the start); NaN if not scanned.
   double scan_rmse_mm = std::numeric_limits<double>::quiet_NaN();
 };
