@@ -7,6 +7,8 @@
 
 #include "calib/candidate_screening.h"
 #include "calib/cell_search.h"
+#include "calib/final_model.h"
+#include "calib/range_start.h"
 #include "calib/gain_by_capture.h"
 #include "calib/like_with_like.h"
 
@@ -320,38 +322,6 @@ void scan_and_screen(const Selection& s, const std::vector<std::string>& remaini
   }
 }
 
-// Short joint fits from values spanning the new parameter's range and from
-// the scan's start (multi_start.h); the refit starts from the best.
-void start_from_best_of_range(const Selection& s, CandidateFit& c) {
-  if (s.options.multi_start.starts < 1 || !wants_multi_start(c.added)) return;
-  const auto parameters = fit_parameters(c.effects);
-  const ModelParams scanned = c.scanned_start ? *c.scanned_start : with_effects(s.current.params, c.effects);
-  if (s.progress) s.progress("multi-start " + c.added, 0, 1, "");
-  MultiStart range = multi_start(s.dataset, scanned, parameters, c.added, s.options.fit.least_squares,
-                                 s.options.multi_start);
-  // The scan's start on the same footing: its own short fit.
-  LeastSquaresOptions short_fit = s.options.fit.least_squares;
-  short_fit.max_iterations = s.options.multi_start.iterations;
-  c.multi_start_parameter = range.parameter;
-  c.starts_tried = range.tried;
-  try {
-    const LeastSquaresResult from_scan = fit_least_squares(s.dataset, scanned, parameters, short_fit);
-    for (const auto& p : parameters)
-      if (!p.surface && p.effect == c.added)
-        c.starts_tried.push_back({parameter_value(scanned, p), from_scan.rmse_mm, parameter_value(from_scan.params, p)});
-    if (from_scan.sum_sq_mm2 <= range.best_sum_sq_mm2) {
-      c.scanned_start = from_scan.params;
-      range.found = false;
-    }
-  } catch (const SettleInterrupted&) {
-    throw;
-  } catch (const std::exception&) {
-    // The scan's start does not replay: the range's best stands.
-  }
-  if (range.found) c.scanned_start = range.best;
-  if (s.progress) s.progress("multi-start " + c.added, 1, 1, "");
-}
-
 // Refits one candidate from the current optimum, cross-validates it and
 // judges it; false (and said so in out.skipped) if the model cannot replay it.
 bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
@@ -363,7 +333,7 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
   // Warm start: the current model's optimum, the new effect where the scan
   // found it best, or where the best short fit over its range ended.
   try {
-    start_from_best_of_range(s, c);
+    start_from_best_of_range(s.dataset, s.current.params, s.options, s.progress, c);
     c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options,
                           [&](int iteration, int max_iterations, double rmse) {
                             if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
@@ -478,34 +448,6 @@ std::vector<std::string> effects_for_next_round(const std::vector<CandidateFit>&
                                   (c.screened_out && c.heldout_replayed && c.delta_bic < best.delta_bic)))
       next.push_back(c.added);
   return next;
-}
-
-// The final model against the sensor's noise (goodness_of_fit.h), where its
-// residual concentrates, and the lowest RMSE any refitted candidate reached.
-void judge_final_model(const Dataset& dataset, const DiagnoseOptions& options, const LeastSquaresResult& final_fit,
-                       Diagnosis& out) {
-  out.goodness = goodness_of_fit(final_fit, out.noise_floor_mm, options.goodness);
-  out.final_pattern = out.verdict.empty()
-                          ? out.pattern
-                          : describe_residuals(dataset, evaluate_dataset(dataset, final_fit.params,
-                                                                         options.fit.least_squares.replay));
-  for (const auto& e : out.verdict)
-    if (is_cell_effect(e)) {
-      const auto& v = out.final_params.effect_parameters.at(e);
-      out.worst_cells.push_back({static_cast<int>(std::lround(v.at("row"))), static_cast<int>(std::lround(v.at("col")))});
-    }
-  for (const auto& cell : out.pattern.worst_cells)
-    if (out.worst_cells.size() < out.pattern.worst_cells.size() &&
-        std::find(out.worst_cells.begin(), out.worst_cells.end(), cell) == out.worst_cells.end())
-      out.worst_cells.push_back(cell);
-  out.best_rmse_mm = final_fit.rmse_mm;
-  out.best_effects = out.verdict;
-  for (const auto* record : {&out.ranking, &out.later_rounds})
-    for (const CandidateFit& c : *record)
-      if (!c.screened_out && std::isfinite(c.fit.rmse_mm) && c.fit.rmse_mm < out.best_rmse_mm) {
-        out.best_rmse_mm = c.fit.rmse_mm;
-        out.best_effects = c.effects;
-      }
 }
 
 }  // namespace
