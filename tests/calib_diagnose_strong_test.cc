@@ -34,6 +34,7 @@ TEST(CalibDiagnoseStrong, AStrongStiffeningIsDiagnosedAsStiffening) {
   DiagnoseOptions o;
   o.candidates = {"stiffening", "cell_stiffness", "sensor_tilt"};
   o.max_effects = 1;
+  o.multi_start.starts = 4;
   o.fit.least_squares.max_iterations = 10;
   const Diagnosis result = diagnose(d, ModelParams{}, o);
   ASSERT_EQ(result.verdict, std::vector<std::string>{"stiffening"}) << verdict_sentence(result);
