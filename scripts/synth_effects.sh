@@ -53,20 +53,47 @@ source_dataset="$repo/../shared/data/sessions/demo-baseline"
 # "RMSE vs baseline").
 cases=(
   "none||"
+  # Every effect at three magnitudes: small, middle, near the largest that
+  # synthesises on these sessions (the bound itself has no equilibrium for
+  # some, e.g. area_pressure 0.5).
+  "bending_small|bending|bending.kappa_bend=0.0005"
   "bending|bending|bending.kappa_bend=0.002"
-  "stiffening|stiffening|stiffening.beta=0.5"
+  "bending_large|bending|bending.kappa_bend=0.01"
+  "stiffening_small|stiffening|stiffening.beta=0.5"
+  "stiffening|stiffening|stiffening.beta=50"
+  "stiffening_large|stiffening|stiffening.beta=600"
+  "jam_contraction_small|jam_contraction|jam_contraction.contraction=0.02"
   "jam_contraction|jam_contraction|jam_contraction.contraction=0.05"
+  "jam_contraction_large|jam_contraction|jam_contraction.contraction=0.2"
   "jam_creep|jam_creep|jam_creep.creep_per_settle=0.5"
   # At its bound: on these sessions 0.5 barely moves the frames; with
   # --sessions jammed-sweep,... this one does (0.65 mm on jammed-sweep).
   "jam_creep_fast|jam_creep|jam_creep.creep_per_settle=1"
+  "cell_stiffness_small|cell_stiffness|cell_stiffness.grad_x=0.05,cell_stiffness.bulge=-0.05"
   "cell_stiffness|cell_stiffness|cell_stiffness.grad_x=0.15,cell_stiffness.bulge=-0.15"
+  "cell_stiffness_large|cell_stiffness|cell_stiffness.grad_x=0.28,cell_stiffness.bulge=-0.28"
+  "area_pressure_small|area_pressure|area_pressure.weight=0.03"
   "area_pressure|area_pressure|area_pressure.weight=0.1"
+  "area_pressure_large|area_pressure|area_pressure.weight=0.3"
+  "boundary_compliance_small|boundary_compliance|boundary_compliance.k_edge=2000"
   "boundary_compliance|boundary_compliance|boundary_compliance.k_edge=200"
+  "boundary_compliance_large|boundary_compliance|boundary_compliance.k_edge=30"
+  "sensor_tilt_small|sensor_tilt|sensor_tilt.tilt_x_mrad=5,sensor_tilt.tilt_y_mrad=-3,sensor_tilt.offset_mm=0.5"
   "sensor_tilt|sensor_tilt|sensor_tilt.tilt_x_mrad=15,sensor_tilt.tilt_y_mrad=-10,sensor_tilt.offset_mm=1.5"
+  "sensor_tilt_large|sensor_tilt|sensor_tilt.tilt_x_mrad=45,sensor_tilt.tilt_y_mrad=-40,sensor_tilt.offset_mm=15"
+  "pressure_offset_small|pressure_offset|pressure_offset.gain=1.02,pressure_offset.offset_pa=10"
   "pressure_offset|pressure_offset|pressure_offset.gain=1.05,pressure_offset.offset_pa=40"
+  "pressure_offset_large|pressure_offset|pressure_offset.gain=1.4,pressure_offset.offset_pa=400"
+  # One cell softer than the rest, at two magnitudes in two cells.
+  "cell_defect_1_1_soft|cell_defect|cell_defect.factor=0.6,cell_defect.row=1,cell_defect.col=1"
+  "cell_defect_1_1_softer|cell_defect|cell_defect.factor=0.3,cell_defect.row=1,cell_defect.col=1"
+  "cell_defect_2_3_soft|cell_defect|cell_defect.factor=0.6,cell_defect.row=2,cell_defect.col=3"
+  "cell_defect_2_3_stiff|cell_defect|cell_defect.factor=3,cell_defect.row=2,cell_defect.col=3"
+  # One physical effect and one of the camera.
   "bending+sensor_tilt|bending,sensor_tilt|bending.kappa_bend=0.002,sensor_tilt.tilt_x_mrad=15,sensor_tilt.tilt_y_mrad=-10,sensor_tilt.offset_mm=1.5"
   "jam_contraction+pressure_offset|jam_contraction,pressure_offset|jam_contraction.contraction=0.05,pressure_offset.gain=1.05,pressure_offset.offset_pa=40"
+  "stiffening_large+sensor_tilt|stiffening,sensor_tilt|stiffening.beta=600,sensor_tilt.tilt_x_mrad=15,sensor_tilt.tilt_y_mrad=-10,sensor_tilt.offset_mm=1.5"
+  "cell_defect+pressure_offset|cell_defect,pressure_offset|cell_defect.factor=0.5,cell_defect.row=1,cell_defect.col=2,pressure_offset.gain=1.05,pressure_offset.offset_pa=40"
   "stiffening+cell_stiffness|stiffening,cell_stiffness|stiffening.beta=0.5,cell_stiffness.grad_x=0.15,cell_stiffness.bulge=-0.15"
 )
 

@@ -65,7 +65,7 @@ def row(work, case):
     floor = summary.get("noise_floor_mm", 1.04) if summary else 1.04
     signal = math.sqrt(max(rmse * rmse - floor * floor, 0.0)) if summary else float("nan")
     if diag is None:
-        return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal), "not run", "", "", "", "", ""]
+        return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal), "not run", "", "", "", "", "", "", ""]
     verdict = ", ".join(diag["verdict"]) or "none"
     correct = sorted(diag["verdict"]) == sorted(truth.get("effects", {}))
     ranking = []
@@ -82,10 +82,12 @@ def row(work, case):
     surface = diag["final_params"]["surface"]
     surface_text = "m %.3f, k %.1f, kj %.2f" % (surface["mass_kg"], surface["spring_k"], surface["kappa_jam"])
     ladder = diag["ladder"]
-    rmse_text = "%.3f -> %.3f" % (ladder[0]["rmse_mm"], ladder[-1]["rmse_mm"])
+    rmse_text = "%.3f -> %.3f (floor %.3f)" % (ladder[0]["rmse_mm"], ladder[-1]["rmse_mm"], diag["noise_floor_mm"])
+    explained = diag.get("explained")
+    explained_text = "-" if explained is None else ("yes" if explained else "**no**")
     return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal),
             ("**%s**" if correct else "%s (WRONG)") % verdict, "<br>".join(ranking), "<br>".join(fitted) or "-",
-            surface_text, rmse_text, "%.0f" % diag["cpu_seconds"]]
+            surface_text, rmse_text, explained_text, "%.0f" % diag["seconds"], "%.0f" % diag["cpu_seconds"]]
 
 
 def main():
@@ -94,7 +96,7 @@ def main():
     work, sessions, cases = sys.argv[1], sys.argv[2], sys.argv[3:]
     head = ["dataset", "true effects", "true parameters", "RMSE vs baseline mm (effect alone)", "verdict",
             "ranking top 3: delta BIC (* significant, s screened out)", "fitted vs true", "final m kg, k N/m, kappa_jam",
-            "RMSE mm baseline -> final", "CPU s"]
+            "RMSE mm baseline -> final", "explained", "wall s", "CPU s"]
     print("Sessions of demo-baseline replayed: %s." % sessions.replace(",", ", "))
     print()
     print("| " + " | ".join(head) + " |")

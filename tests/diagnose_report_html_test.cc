@@ -49,6 +49,7 @@ Diagnosis bending_found() {
   d.later_rounds = {candidate("stiffening", 1.059, 1.12, 6.1)};
   d.later_rounds[0].effects = {"bending", "stiffening"};
   d.verdict = {"bending"};
+  d.goodness = {1.06, 1.04, 6240.0, 6000, 0.015, 0.205, true};
   d.ladder = {{"baseline", 2.5, 2.75}, {"+ bending", 1.06, 1.1}};
   d.pattern.findings = {"The residual concentrates in jammed cells (RMSE 3.1 mm against 1.9 mm elsewhere)."};
   d.pattern.splits = {{"in jammed cells", "elsewhere", 3.1, 1.9, 1200, 4800}};
@@ -101,6 +102,32 @@ TEST(DiagnoseReportHtml, SaysWhenNoEffectIsNeededAndTheServersRunTimeHasNoCpu) {
   EXPECT_EQ(html.find("Later rounds"), std::string::npos);
   EXPECT_NE(html.find("Run time 3.0 s.</p>"), std::string::npos);
   EXPECT_EQ(html.find("CPU"), std::string::npos);
+}
+
+// A baseline well above the floor is never "no effect is needed": the
+// verdict says how far above, how low the best candidate got, and where
+// the residual is.
+TEST(DiagnoseReportHtml, SaysTheModelDoesNotExplainTheDataAboveTheFloor) {
+  Diagnosis d = bending_found();
+  d.verdict.clear();
+  d.ranking[0].significant = false;
+  d.goodness = {2.5, 1.04, 34670.0, 6000, 0.0, 2.27, false};
+  d.best_rmse_mm = 2.4;
+  d.best_effects = {"area_pressure"};
+  d.final_pattern.worst_cells = {{1, 2}, {0, 2}};
+  d.final_pattern.worst_cell_rmse_mm = {3.1, 1.5};
+  d.final_pattern.splits = {{"near the clamped edge", "inside", 1.0, 2.9, 100, 200}};
+  EXPECT_EQ(verdict_sentence(d),
+            "The model does not explain the data: RMSE 2.500 mm against a floor of 1.040 mm; the best candidates "
+            "lower it to 2.400 mm (area_pressure); the residual concentrates in cells [1, 2] (3.10 mm), [0, 2] "
+            "(1.50 mm).");
+  const std::string html = diagnose_report_html("bump", d, DiagnoseOptions{}, {3.0, std::nullopt});
+  EXPECT_EQ(html.find("No effect is needed"), std::string::npos);
+  EXPECT_NE(html.find("not the sensor's noise alone"), std::string::npos);
+  d.verdict = {"bending"};
+  EXPECT_EQ(verdict_sentence(d).rfind("The data need at least: bending; but the model does not explain the data", 0),
+            0u)
+      << verdict_sentence(d);
 }
 
 }  // namespace

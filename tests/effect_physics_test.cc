@@ -71,6 +71,7 @@ INSTANTIATE_TEST_SUITE_P(Effects, EffectAtNoOpValues,
                                          NoOp{"jam_contraction", {{"contraction", 0.0}}},
                                          NoOp{"jam_creep", {{"creep_per_settle", 0.0}}},
                                          NoOp{"cell_stiffness", {{"grad_x", 0.0}, {"grad_y", 0.0}, {"bulge", 0.0}}},
+                                         NoOp{"cell_defect", {{"factor", 1.0}, {"row", 1}, {"col", 1}}},
                                          NoOp{"area_pressure", {{"weight", 0.0}}},
                                          NoOp{"pressure_offset", {{"gain", 1.0}, {"offset_pa", 0.0}}},
                                          NoOp{"sensor_tilt", {}}),
@@ -152,6 +153,19 @@ TEST(CellStiffness, AStifferSideBulgesLess) {
   EXPECT_LT(centre_z(graded, 1, 3), centre_z(graded, 1, 0) - 1e-4) << "+x is stiffer";
   const Simulator bulged = device(with({{"cell_stiffness", {{"bulge", -0.3}}}}), bulge);
   EXPECT_GT(centre_z(bulged, 1, 1), centre_z(even, 1, 1) + 1e-4) << "a softer middle bulges more";
+}
+
+TEST(CellDefect, ASoftCellBulgesMoreThanItsMirrorImage) {
+  const std::vector<Action> bulge = {Action::set_pressure(2000.0)};
+  const Simulator even = device({}, bulge);
+  const Simulator soft = device(with({{"cell_defect", {{"factor", 0.4}, {"row", 1}, {"col", 2}}}}), bulge);
+  EXPECT_GT(centre_z(soft, 1, 2), centre_z(even, 1, 2) + 1e-3) << "the soft cell bulges more";
+  EXPECT_GT(centre_z(soft, 1, 2), centre_z(soft, 1, 1) + 1e-3) << "than its mirror image";
+  const Simulator stiff = device(with({{"cell_defect", {{"factor", 3.0}, {"row", 1}, {"col", 2}}}}), bulge);
+  EXPECT_LT(centre_z(stiff, 1, 2), centre_z(even, 1, 2) - 1e-3) << "a stiff cell bulges less";
+  // A cell outside the array is no cell of it.
+  const Simulator nowhere = device(with({{"cell_defect", {{"factor", 0.4}, {"row", 40}, {"col", 40}}}}), bulge);
+  EXPECT_LT(max_difference(nowhere.state().x, even.state().x), 1e-9);
 }
 
 TEST(AreaPressure, AStretchedSurfaceCarriesMoreLoad) {

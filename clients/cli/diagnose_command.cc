@@ -36,7 +36,9 @@ nlohmann::json time_split(const nlohmann::json& timing) {
   auto part_of = [](const std::string& stage) -> std::string {
     if (stage.rfind("recheck ", 0) == 0 || stage.find("(refitted from ") != std::string::npos) return "rechecks";
     if (stage.rfind("screening ", 0) == 0 || stage.rfind("scan ", 0) == 0) return "screening";
-    if (stage.rfind("candidate ", 0) == 0 || stage.rfind("converging baseline + ", 0) == 0) return "refits";
+    if (stage.rfind("candidate ", 0) == 0 || stage.rfind("multi-start ", 0) == 0 ||
+        stage.rfind("converging baseline + ", 0) == 0)
+      return "refits";
     if (stage == "cross-validation" || stage == "residual pattern") return stage;
     return "baseline fit";
   };
@@ -114,6 +116,8 @@ int diagnose_dataset(const CalibArgs& args) {
     std::printf("  replays of %-20s %5ld x %6.3f s CPU = %7.1f s%s\n", e.session.c_str(), e.replays,
                 e.replays ? e.cpu_s / e.replays : 0.0, e.cpu_s,
                 e.failed ? (" (" + std::to_string(e.failed) + " failed)").c_str() : "");
+  std::printf("final model: %s; %s\n", fit_quality_sentence(d).c_str(),
+              d.goodness.explained ? "consistent with the sensor's noise" : "NOT explained by the sensor's noise");
   std::printf("%s\nwrote %s in %.1f s (CPU %.1f s)\n", verdict_text.c_str(), (out / "diagnosis.json").c_str(), seconds,
               cpu_seconds);
   return 0;

@@ -21,6 +21,12 @@ nlohmann::json candidate_json(const CandidateFit& c) {
   if (c.screened_out) j["screening"] = c.screening_note;
   if (!c.scan_note.empty()) j["scan"] = c.scan_note;
   if (!c.recheck_note.empty()) j["recheck"] = c.recheck_note;
+  if (!c.starts_tried.empty()) {
+    nlohmann::json starts = nlohmann::json::array();
+    for (const auto& t : c.starts_tried)
+      starts.push_back({{"start", t.value}, {"fitted", t.fitted}, {"rmse_mm", t.rmse_mm}});
+    j["starts"] = {{"parameter", c.multi_start_parameter}, {"tried", starts}};
+  }
   if (c.screened)
     j["predicted"] = {{"rmse_mm", c.predicted_rmse_mm},
                       {"heldout_rmse_mm", c.predicted_heldout_rmse_mm},
@@ -177,7 +183,11 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
   nlohmann::json ranking = nlohmann::json::array(), later = nlohmann::json::array(), worst = nlohmann::json::array();
   for (const auto& c : d.ranking) ranking.push_back(candidate_json(c));
   for (const auto& c : d.later_rounds) later.push_back(candidate_json(c));
-  for (auto [r, c] : d.pattern.worst_cells) worst.push_back({r, c});
+  for (auto [r, c] : d.worst_cells) worst.push_back({r, c});
+  nlohmann::json baseline_worst = nlohmann::json::array();
+  for (auto [r, c] : d.pattern.worst_cells) baseline_worst.push_back({r, c});
+  nlohmann::json final_worst = nlohmann::json::array();
+  for (auto [r, c] : d.final_pattern.worst_cells) final_worst.push_back({r, c});
   nlohmann::json ladder = nlohmann::json::array();
   for (const auto& step : d.ladder)
     ladder.push_back({{"model", step.label}, {"rmse_mm", step.rmse_mm}, {"heldout_rmse_mm", step.heldout_rmse_mm}});
@@ -192,11 +202,28 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
           {"later_rounds", later},
           {"verdict", d.verdict},
           {"worst_cells", worst},
+          {"baseline_worst_cells", baseline_worst},
           {"findings", d.pattern.findings},
           {"skipped", d.skipped},
           {"notes", d.notes},
           {"ladder", ladder},
           {"noise_floor_mm", d.noise_floor_mm},
+          {"explained", d.goodness.explained},
+          {"goodness_of_fit",
+           {{"rmse_mm", d.goodness.rmse_mm},
+            {"noise_floor_mm", d.goodness.noise_floor_mm},
+            {"chi2", d.goodness.chi2},
+            {"dof", d.goodness.dof},
+            {"p_value", d.goodness.p_value},
+            {"systematic_mm", d.goodness.systematic_mm},
+            {"explained", d.goodness.explained}}},
+          {"chi2", d.goodness.chi2},
+          {"dof", d.goodness.dof},
+          {"p_value", d.goodness.p_value},
+          {"best_rmse_mm", d.best_rmse_mm},
+          {"best_effects", d.best_effects},
+          {"final_worst_cells", final_worst},
+          {"final_findings", d.final_pattern.findings},
           {"final_params", model_params_json(d.final_params)}};
 }
 

@@ -6,6 +6,9 @@
 #include <limits>
 
 #include "calib/candidate_screening.h"
+#include "calib/cell_search.h"
+#include "calib/final_model.h"
+#include "calib/range_start.h"
 #include "calib/gain_by_capture.h"
 #include "calib/like_with_like.h"
 
@@ -275,12 +278,20 @@ CandidateFit scanned_candidate(const Selection& s, const std::string& effect) {
   const auto parameters = fit_parameters(c.effects);
   if (s.progress) s.progress("scan " + effect, 0, 1, "");
   try {
-    EffectScan scan = scan_effect_start(s.dataset, with_effects(s.current.params, c.effects), parameters, effect,
-                                        s.options.fit.least_squares.replay, s.options.scan_options);
+    ModelParams start = with_effects(s.current.params, c.effects);
+    if (is_cell_effect(effect)) {
+      // Which cell: a search no local fit can make (cell_search.h).
+      CellSearch cell = search_cells(s.dataset, start, parameters, effect, s.current, s.options.fit.least_squares.replay);
+      start = cell.best;
+      c.scanned_start = start;
+      c.scan_note = cell.note;
+    }
+    EffectScan scan = scan_effect_start(s.dataset, start, parameters, effect, s.options.fit.least_squares.replay,
+                                        s.options.scan_options);
     c.scan_rmse_mm = std::sqrt(scan.best_sum_sq_mm2 / std::max(s.current.residual_count, 1L));
     if (scan.moved) {
       c.scanned_start = std::move(scan.best);
-      c.scan_note = scan.note;
+      c.scan_note += (c.scan_note.empty() ? "" : "; ") + scan.note;
     }
   } catch (const SettleInterrupted&) {
     throw;  // the caller stopped the work: not a failed replay
@@ -320,8 +331,9 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
   const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
   const DiagnoseProgress& progress = s.progress;
   // Warm start: the current model's optimum, the new effect where the scan
-  // found it best.
+  // found it best, or where the best short fit over its range ended.
   try {
+    start_from_best_of_range(s.dataset, s.current.params, s.options, s.progress, c);
     c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options,
                           [&](int iteration, int max_iterations, double rmse) {
                             if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
@@ -468,6 +480,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   }
   out.verdict = s.chosen;
   out.final_params = s.current.params;
+  judge_final_model(dataset, options, s.current, out);
   return out;
 }
 

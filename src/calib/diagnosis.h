@@ -13,6 +13,8 @@
 #include "calib/cross_validation.h"
 #include "calib/effect_scan.h"
 #include "calib/fit_model.h"
+#include "calib/goodness_of_fit.h"
+#include "calib/multi_start.h"
 #include "calib/residual_pattern.h"
 #include "calib/screening.h"
 
@@ -56,6 +58,16 @@ struct DiagnoseOptions {
   // that passes the screening.
   double refit_cutoff = 2.0;
   EffectScanOptions scan_options;
+  // A refitted candidate with one parameter starts from the best of short
+  // joint fits from values spanning that parameter's range and from the
+  // scan's start (multi_start.h). starts = 0: from the scan's start only.
+  // Off by default: on demo-bending's cheap sessions its short fits took
+  // Diagnose.FindsTheBendingStiffnessInDemoBending past 10 minutes on the
+  // loaded 2-core machine; it must first be made to run only where the
+  // local refit leaves the model unexplained.
+  MultiStartOptions multi_start{0, 2};
+  // Whether the final model explains the data (goodness_of_fit.h).
+  GoodnessOfFitOptions goodness;
   // A candidate whose predicted delta BIC passes but whose predicted
   // held-out gain does not is screened out only if replaying the held-out
   // sessions at the folds' predicted parameters (one replay of the
@@ -83,6 +95,10 @@ struct CandidateFit {
   // candidate's figures: refitted, or no longer significant.
   std::string recheck_note;
   std::optional<ModelParams> scanned_start;
+  // The multi-start's short fits (multi_start.h), the scan's start last;
+  // empty if it did not run.
+  std::string multi_start_parameter;
+  std::vector<StartTried> starts_tried;
   // The RMSE at the scan's best point (or the start); NaN if not scanned.
   double scan_rmse_mm = std::numeric_limits<double>::quiet_NaN();
 };
@@ -105,6 +121,18 @@ struct Diagnosis {
   std::vector<std::string> skipped;   // candidates that failed to fit, with why
   std::vector<std::string> notes;     // e.g. a model whose fit did not converge
   double noise_floor_mm = 0.0;
+  // The final model's residuals against the sensor's noise model: "no
+  // effect is needed" only where the baseline passes it.
+  GoodnessOfFit goodness;
+  // Where the final model's residual concentrates (the baseline's pattern
+  // when nothing was chosen).
+  ResidualPattern final_pattern;
+  // Where the missing effect is, worst first: the cell of a chosen local
+  // effect (cell_defect), then the baseline residual's worst cells.
+  std::vector<std::pair<int, int>> worst_cells;
+  // The lowest in-sample RMSE any refitted model reached, and its effects.
+  double best_rmse_mm = 0.0;
+  std::vector<std::string> best_effects;
 };
 
 // BIC of a least-squares fit with Gaussian residuals: n ln(SSR / n) + p ln n.

@@ -6,6 +6,8 @@
 
 namespace hj {
 
+bool is_fitted(const ParameterSpec& spec) { return spec.unit != "cell"; }
+
 std::vector<FitParameter> fit_parameters(const std::vector<std::string>& effects) {
   const auto& registry = EffectRegistry::instance();
   std::vector<FitParameter> out;
@@ -17,7 +19,8 @@ std::vector<FitParameter> fit_parameters(const std::vector<std::string>& effects
   for (const auto& name : effects) {
     const EffectInfo& info = registry.get(name);
     if (info.baseline) throw std::invalid_argument("effect \"" + name + "\" is part of the baseline already");
-    for (const auto& spec : info.parameters) out.push_back({name, spec, false});
+    for (const auto& spec : info.parameters)
+      if (is_fitted(spec)) out.push_back({name, spec, false});
   }
   return out;
 }

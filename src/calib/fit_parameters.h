@@ -21,7 +21,12 @@ struct FitParameter {
   std::string qualified_name() const { return surface ? spec.name : effect + "." + spec.name; }
 };
 
-// The baseline's parameters, then each of `effects`' in order.
+// False for a parameter of unit "cell" (cell_defect's row and col): it
+// names a cell of the array, a discrete choice no fit can move; diagnose
+// searches it (cell_search.h).
+bool is_fitted(const ParameterSpec& spec);
+
+// The baseline's parameters, then each of `effects`' fitted ones in order.
 // @throws std::invalid_argument naming an unknown effect.
 std::vector<FitParameter> fit_parameters(const std::vector<std::string>& effects);
 

@@ -26,6 +26,8 @@ std::string candidate_note(const CandidateFit& c);
 
 // "The data need: a, b." or that no effect is needed (the page's verdict).
 std::string verdict_sentence(const Diagnosis& diagnosis);
+// "RMSE 1.043 mm against a noise floor of 1.041 mm (chi-square ... p = 0.2)".
+std::string fit_quality_sentence(const Diagnosis& diagnosis);
 
 // @param dataset_name  shown in the title
 // @param options       the diagnosis's options (the page states its significance thresholds)

@@ -1,0 +1,39 @@
+// Where is a local defect? An effect with unfitted "row" and "col"
+// parameters (cell_defect) acts on one cell, which no local fit can move
+// between cells. Before its scan, each cell of the array is tried: the
+// dataset is replayed with the effect in that cell at each probe of its
+// fitted parameters (halfway to each bound, geometrically for a positive
+// default: cell_defect's factor 0.45 and 2.24), and the cell and probe of
+// lowest sum of squares are where the scan and refit start. Each point's
+// sum of squares is taken with the current model's parameters re-solved
+// along its Jacobian (the residual projected off its columns): a baseline
+// fitted to a soft cell has softened every spring, and a soft probe in the
+// right cell only beats a stiff one elsewhere once k may rise again.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/fit_parameters.h"
+#include "calib/least_squares.h"
+
+namespace hj {
+
+// True if `effect` has the unfitted "row" and "col" parameters of a cell.
+bool is_cell_effect(const std::string& effect);
+
+struct CellSearch {
+  ModelParams best;  // the start with the effect moved to the best cell and probe
+  int row = -1, col = -1;
+  double best_sum_sq_mm2 = 0.0;
+  int replays = 0;
+  std::string note;  // "cell_defect at cell [1, 2], factor 0.447 (sum of squares -31.0 %)"
+};
+
+// @param start  the current model with `effect` switched on
+// @param current  the current model's fit (its Jacobian and sum of squares)
+// @throws std::runtime_error if no cell and probe replays
+CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const std::vector<FitParameter>& parameters,
+                        const std::string& effect, const LeastSquaresResult& current, const ReplayOptions& replay);
+
+}  // namespace hj
