@@ -12,7 +12,7 @@ PlanningOutput run_planning(const PlanningInput& input, const PlanCallbacks& cal
   PlanningOutput out;
   out.planner = planner->name();
   PlanRequest request{input.array.geometry, input.array.params,
-                      resample_to_mesh(input.goal, mesh, relief_or_default_mm(input.max_height_mm, input.array.geometry)),
+                      goal_to_mesh(input.goal, mesh, input.heights, input.max_height_mm),
                       input.array.simulator, input.goal.z};
   out.result = planner->plan(request, callbacks);
   out.goal_mm = std::move(request.goal_mm);

@@ -11,6 +11,7 @@
 #include "plan/planner.h"
 #include "proto_convert.h"
 #include "shapes/height_map.h"
+#include "shapes/resample.h"
 
 namespace hj::server {
 
@@ -19,6 +20,7 @@ struct PlanningInput {
   HeightMap goal;
   double max_height_mm = 0.0;  // 0: the array's default relief
   std::string planner = "algorithm2";
+  GoalHeights heights = GoalHeights::kScaled;
 };
 
 struct PlanningOutput {

@@ -74,7 +74,8 @@ grpc::Status PlanningServiceImpl::plan_or_cached(grpc::ServerContext* context, c
     try {
       PlanningInput input{array_from_proto(request.array(), limits), load_goal(request.goal(), maps, limits),
                           max_height_from_proto(request.goal().options()),
-                          request.planner().empty() ? "algorithm2" : request.planner()};
+                          request.planner().empty() ? "algorithm2" : request.planner(),
+                          heights_from_proto(request.goal())};
       const Mesh mesh(input.array.geometry);
       int settled = 0;
       PlanCallbacks callbacks;

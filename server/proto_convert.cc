@@ -87,6 +87,19 @@ double max_height_from_proto(const v1::GoalOptions& options) {
   return h;
 }
 
+GoalHeights heights_from_proto(const v1::Goal& goal) {
+  switch (goal.options().heights()) {
+    case v1::GOAL_HEIGHTS_UNSPECIFIED:
+    case v1::GOAL_HEIGHTS_SCALED: return GoalHeights::kScaled;
+    case v1::GOAL_HEIGHTS_ABSOLUTE: break;
+    default: throw std::invalid_argument("goal.options.heights: unknown value " + std::to_string(goal.options().heights()));
+  }
+  if (goal.options().max_height_mm() != 0.0)
+    throw std::invalid_argument("goal.options.heights ABSOLUTE and goal.options.max_height_mm exclude each other");
+  if (goal.has_file()) check_absolute_goal_format(goal.file().file_name());
+  return GoalHeights::kAbsolute;
+}
+
 DeviceStep step_from_proto(const v1::Step& step, const std::string& where) {
   DeviceStep out;
   out.label = step.label();

@@ -14,6 +14,7 @@
 #include "model/action.h"
 #include "model/device_state.h"
 #include "shapes/goal_importer.h"
+#include "shapes/resample.h"
 #include "sim/simulator.h"
 
 namespace hj::server {
@@ -37,6 +38,9 @@ ArrayConfig array_from_proto(const v1::ArraySpec& spec, const ServerLimits& limi
 // @throws std::invalid_argument naming the field.
 ImportOptions import_options_from_proto(const v1::GoalOptions& options, const ServerLimits& limits);
 double max_height_from_proto(const v1::GoalOptions& options);
+// Scaled or absolute heights; absolute needs a CSV or TIFF goal file (or a
+// map) and no max_height_mm. @throws std::invalid_argument naming the field.
+GoalHeights heights_from_proto(const v1::Goal& goal);
 
 // A device step: one of the five actions or a capture.
 struct DeviceStep {

@@ -76,6 +76,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   planning_ = std::make_unique<PlanningServiceImpl>(auth_, maps_, options_.limits, *pool_, *cache_);
   device_ = std::make_unique<DeviceServiceImpl>(auth_, *queue_, options_.limits);
   calibration_ = std::make_unique<CalibrationServiceImpl>(auth_, options_.limits, *pool_);
+  render_ = std::make_unique<RenderServiceImpl>(auth_, maps_, options_.limits, *queue_);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -85,6 +86,7 @@ HapticServer::HapticServer(ServerOptions options, std::unique_ptr<device::Device
   builder.RegisterService(planning_.get());
   builder.RegisterService(device_.get());
   builder.RegisterService(calibration_.get());
+  builder.RegisterService(render_.get());
   server_ = builder.BuildAndStart();
   if (!server_ || port_ == 0)
     throw std::runtime_error("cannot listen on " + options_.listen + " (address in use or not valid?)");

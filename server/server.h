@@ -17,6 +17,7 @@
 #include "goal_source.h"
 #include "job_store.h"
 #include "planning_service.h"
+#include "render_service.h"
 #include "result_cache.h"
 #include "server_options.h"
 #include "work_pool.h"
@@ -60,6 +61,7 @@ class HapticServer {
   std::unique_ptr<PlanningServiceImpl> planning_;
   std::unique_ptr<DeviceServiceImpl> device_;
   std::unique_ptr<CalibrationServiceImpl> calibration_;
+  std::unique_ptr<RenderServiceImpl> render_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
 

@@ -28,7 +28,7 @@ namespace {
 
 constexpr const char* kPlanUsage =
     "usage: hapticjam plan GOAL --rows R --cols C --out DIR [--segments P] [--planner NAME]\n"
-    "                      [--max-height-mm H] [--region x0,y0,x1,y1] [--hue] [--json]\n"
+    "                      [--max-height-mm H | --heights absolute] [--region x0,y0,x1,y1] [--hue] [--json]\n"
     "                      [--up-axis [-]x|y|z] [--view-resolution N]\n"
     "                      [--region-lonlat lon0,lat0,lon1,lat1] [--encoding E] [--no-sidecar]\n"
     "Plans the actions that make the display show GOAL (a height image: CSV, PNG,\n"
@@ -42,6 +42,10 @@ constexpr const char* kPlanUsage =
     "  --planner NAME        default algorithm2\n"
     "  --max-height-mm H     goal height range on the display (default: 10 mm per cell\n"
     "                        of the array's shorter side, e.g. 30 mm at 3 x 4, 90 mm at 9 x 12)\n"
+    "  --heights H           scaled (default: stretched to --max-height-mm) or absolute:\n"
+    "                        a CSV or float TIFF taken as mm above the clamped edge's\n"
+    "                        plane (negative allowed); (R p + 1) x (C p + 1) values are\n"
+    "                        the goal at the mesh points (docs/goals.md)\n"
     "  --region x0,y0,x1,y1  zoom: pixels, or fractions of the image if all <= 1\n"
     "  --hue                 colour topographic map: red-orange high, blue-purple low\n"
     "  --json                print the summary as JSON\n"
@@ -57,6 +61,7 @@ struct PlanArgs {
   int rows = 0, cols = 0, segments = 4;
   double max_height_mm = 0.0;  // 0: the array's default relief (default_relief_mm)
   bool hue = false, json = false;
+  GoalHeights heights = GoalHeights::kScaled;
   ImportOptions import;
 };
 
@@ -85,6 +90,7 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
       out.import.mesh_up_axis = axis[0];
     }
     else if (a == "--json") out.json = true;
+    else if (a == "--heights") out.heights = parse_goal_heights(value());
     else if (a == "--max-height-mm") {
       out.max_height_mm = parse_number(a, value());
       if (!(out.max_height_mm > 0.0)) throw std::invalid_argument("--max-height-mm needs a positive number (mm)");
@@ -99,6 +105,10 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
     throw std::invalid_argument("--region and --region-lonlat exclude each other");
   if (out.hue && out.import.encoding != PixelEncoding::kGrey)
     throw std::invalid_argument("--hue and --encoding exclude each other");
+  if (out.heights == GoalHeights::kAbsolute) {
+    if (out.max_height_mm > 0.0) throw std::invalid_argument("--heights absolute and --max-height-mm exclude each other");
+    check_absolute_goal_format(out.goal);
+  }
   return out;
 }
 
@@ -114,9 +124,11 @@ int plan(const PlanArgs& args) {
   if (!args.region_lonlat.empty()) goal = crop_lonlat(goal, parse_lonlat_box(args.region_lonlat));
   const ArrayGeometry geometry{args.rows, args.cols, 0.038, args.segments};
   const Mesh mesh(geometry);
-  const double relief_mm = relief_or_default_mm(args.max_height_mm, geometry);
-  PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry), resample_to_mesh(goal, mesh, relief_mm), {},
-                      goal.z};
+  PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),
+                      goal_to_mesh(goal, mesh, args.heights, args.max_height_mm), {}, goal.z};
+  const bool absolute = args.heights == GoalHeights::kAbsolute;
+  const double relief_mm = absolute ? request.goal_mm.maxCoeff() - request.goal_mm.minCoeff()
+                                    : relief_or_default_mm(args.max_height_mm, geometry);
   const auto planner = make_planner(args.planner);
 
   ProgressLine progress("plan " + std::filesystem::path(args.goal).filename().string());
@@ -150,6 +162,7 @@ int plan(const PlanArgs& args) {
        {{"mass_kg", p.mass_kg}, {"spring_k", p.spring_k}, {"kappa_jam", p.kappa_jam}, {"max_pressure_kpa", p.max_pressure_pa / 1000.0}}},
       {"planner", planner->name()},
       {"max_height_mm", relief_mm},
+      {"heights", absolute ? "absolute" : "scaled"},
       {"steps", steps},
       {"correlation", corr.value ? nlohmann::json(*corr.value) : nlohmann::json(nullptr)},
       {"laplace_mean", laplace}};

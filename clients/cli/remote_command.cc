@@ -16,7 +16,7 @@ const std::vector<Subcommand> kSubcommands = {
     {"plan", run_remote_plan},     {"preview", run_remote_preview}, {"planners", run_remote_planners},
     {"submit", run_remote_submit}, {"watch", run_remote_watch},     {"job", run_remote_job},
     {"cancel", run_remote_cancel}, {"status", run_remote_status},   {"stop", run_remote_stop},
-    {"resume", run_remote_resume}, {"bench", run_remote_bench},
+    {"resume", run_remote_resume}, {"bench", run_remote_bench},     {"render", run_remote_render},
     {"compare", run_remote_compare}, {"fit", run_remote_fit},       {"diagnose", run_remote_diagnose},
 };
 
@@ -33,6 +33,7 @@ constexpr const char* kRemoteUsage =
     "  status                       the device: connection, state, last capture\n"
     "  stop [--reason TEXT]         emergency stop: vent the device now, pause the queue\n"
     "  resume                       let a paused queue run again\n"
+    "  render GOAL --rows R --cols C  render on the device with the loop closed (capture, correct)\n"
     "  bench                        Preview calls per second and latency\n"
     "  compare|fit|diagnose DATASET --out DIR   the measurement workbench on the server\n"
     "Exit codes: 0 done, 2 usage, 10 + the gRPC status code when the server refuses\n"

@@ -2,7 +2,7 @@
 // hapticjam-server, over the public gRPC API only (proto/hapticjam/v1).
 // One family of subcommands per file: remote_planning.cc (plan, preview,
 // planners), remote_device.cc (submit, watch, job, cancel, status, stop,
-// resume), remote_bench.cc (bench).
+// resume), remote_bench.cc (bench), remote_render.cc (render).
 #pragma once
 
 #include <string>
@@ -25,6 +25,7 @@ int run_remote_stop(const std::vector<std::string>& args);
 int run_remote_resume(const std::vector<std::string>& args);
 
 int run_remote_bench(const std::vector<std::string>& args);
+int run_remote_render(const std::vector<std::string>& args);
 
 int run_remote_compare(const std::vector<std::string>& args);
 int run_remote_fit(const std::vector<std::string>& args);

@@ -41,6 +41,11 @@ bool GoalArgs::take(ArgCursor& cursor) {
   } else if (a == "--region") {
     region = cursor.value();
     parse_region_flag(region);
+  } else if (a == "--heights") {
+    const std::string& h = cursor.value();
+    if (h != "absolute" && h != "scaled")
+      throw std::invalid_argument("--heights needs scaled or absolute, got \"" + h + "\"");
+    absolute_heights = h == "absolute";
   } else if (a == "--hue") hue = true;
   else if (a == "--no-sidecar") use_sidecar = false;
   else if (a == "--up-axis") {
@@ -57,6 +62,8 @@ bool GoalArgs::take(ArgCursor& cursor) {
 void GoalArgs::validate() const {
   if (file.empty() == map_name.empty()) throw std::invalid_argument("give a GOAL file or --map NAME (one of them)");
   if (rows == 0 || cols == 0) throw std::invalid_argument("--rows and --cols are required");
+  if (absolute_heights && max_height_mm > 0)
+    throw std::invalid_argument("--heights absolute and --max-height-mm exclude each other");
 }
 
 v1::ArraySpec GoalArgs::array() const {
@@ -92,6 +99,7 @@ v1::Goal GoalArgs::goal() const {
   o->set_up_axis(up_axis);
   o->set_encoding(hue ? v1::HEIGHT_ENCODING_HUE : v1::HEIGHT_ENCODING_UNSPECIFIED);
   o->set_view_resolution(view_resolution);
+  o->set_heights(absolute_heights ? v1::GOAL_HEIGHTS_ABSOLUTE : v1::GOAL_HEIGHTS_UNSPECIFIED);
   return g;
 }
 

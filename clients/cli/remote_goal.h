@@ -18,6 +18,8 @@ constexpr const char* kRemoteGoalUsage =
     "  --cell-mm MM          cell side (default 38)\n"
     "  --planner NAME        default algorithm2\n"
     "  --max-height-mm H     goal height range on the display (default 30 mm)\n"
+    "  --heights absolute    a CSV or float TIFF goal at face value: mm above the clamped\n"
+    "                        edge's plane; (R p + 1) x (C p + 1) values = the mesh points\n"
     "  --region x0,y0,x1,y1  zoom: pixels, or fractions of the image if all <= 1\n"
     "  --hue                 colour topographic map: red-orange high, blue-purple low\n"
     "  --no-sidecar          do not send NAME.json beside the goal (it turns DEMs north-up)\n"
@@ -29,6 +31,7 @@ struct GoalArgs {
   int rows = 0, cols = 0, segments = 0, view_resolution = 0;
   double cell_mm = 0.0, max_height_mm = 0.0;
   bool hue = false;
+  bool absolute_heights = false;  // --heights absolute
   bool use_sidecar = true;  // send NAME.json beside the goal (--no-sidecar: do not)
 
   // Consumes one goal or array flag, or the GOAL argument; false if the

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "calib/rasterize.h"
+#include "calib/replay.h"
 
 namespace hj::device {
 
@@ -62,6 +63,7 @@ std::string Emulator::handle(const protocol::Request& r) {
     case Command::kPing: return protocol::format_ok(r.id);
     case Command::kStatus: return protocol::format_ok(r.id, protocol::format_status(status()));
     case Command::kCapture: return protocol::format_ok(r.id, protocol::format_capture(capture()));
+    case Command::kTruth: return protocol::format_ok(r.id, protocol::format_capture(truth()));
     case Command::kVent: return vent(r.id);
     case Command::kAction: return act(r.id, r.action);
     case Command::kFault: break;
@@ -120,11 +122,24 @@ Eigen::MatrixXd Emulator::exact_frame() const {
   return rasterize_top_view(simulator_.mesh(), simulator_.state().x, config_.camera.grid);
 }
 
+Eigen::MatrixXd Emulator::camera_frame() const {
+  Eigen::MatrixXd heights = exact_frame();
+  simulator_.model().adjust_measurement(sample_x_mm(config_.camera.grid), sample_y_mm(config_.camera.grid), heights);
+  return heights;
+}
+
+Capture Emulator::truth() const {
+  Capture c;
+  c.grid = to_capture_grid(config_.camera.grid);
+  c.heights_mm = exact_frame();
+  return c;
+}
+
 Capture Emulator::capture() {
   const CameraOptions& cam = config_.camera;
   Capture c;
   c.grid = to_capture_grid(cam.grid);
-  c.heights_mm = exact_frame();
+  c.heights_mm = camera_frame();
   std::normal_distribution<double> noise(0.0, cam.noise_mm);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   for (Eigen::Index i = 0; i < c.heights_mm.size(); ++i) {

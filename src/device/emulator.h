@@ -50,14 +50,19 @@ class Emulator {
   std::string handle(const protocol::Request& request);
 
   const Simulator& simulator() const { return simulator_; }
-  // What a capture sees before noise: the surface on the grid, mm.
+  // The true surface on the camera grid, mm: no measurement effect (a tilted
+  // camera), no noise. The "truth" command's answer.
   Eigen::MatrixXd exact_frame() const;
+  // What a capture sees before noise: the true surface as the measurement
+  // effects of the emulator's params (sensor_tilt) change it.
+  Eigen::MatrixXd camera_frame() const;
 
  private:
   std::string act(std::uint64_t id, const Action& action);
   std::string vent(std::uint64_t id);
   protocol::StatusPayload status() const;
   Capture capture();
+  Capture truth() const;
 
   EmulatorConfig config_;
   Simulator simulator_;

@@ -18,12 +18,14 @@ const char* const kEmulatorUsage =
     "  --rows R --cols C      cells of the array (default 3 x 4)\n"
     "  --segments P           mesh segments per cell edge, 2..64 (default 4)\n"
     "  --cell-mm MM           cell side (default 38)\n"
-    "  --params FILE          model parameters and effects (hapticjam.params/1)\n"
+    "  --params FILE          model parameters and effects (hapticjam.params/1), e.g.\n"
+    "                         a device the planner does not know; a measurement\n"
+    "                         effect (sensor_tilt) changes the captures only\n"
     "  --effects a,b          switch on extra effects by name, default values\n"
     "  --max-pressure-kpa K   the device's pressure limit (default 3.45)\n"
     "  --grid nx,ny,x0,y0,dx,dy  capture grid in mm (default: 2 mm covering\n"
     "                         the array, e.g. 77,58,0,0,2,2 for 3 x 4 x 38 mm)\n"
-    "  --noise-mm SIGMA       Gaussian camera noise; as in the shared sessions it\n"
+    "  --noise-mm SIGMA       (or --camera-noise-mm) Gaussian camera noise; as in the shared sessions it\n"
     "                         also rounds to 1 mm and drops 1 % of the samples,\n"
     "                         unless --resolution-mm / --dropout say otherwise\n"
     "                         (default 0: exact frames)\n"
@@ -141,7 +143,7 @@ EmulatorProgramOptions parse_emulator_options(const std::vector<std::string>& ar
       max_pressure_kpa = number(a, value());
       if (*max_pressure_kpa <= 0.0) throw std::invalid_argument("--max-pressure-kpa: must be > 0 kPa");
     } else if (a == "--grid") grid_text = value();
-    else if (a == "--noise-mm") camera.noise_mm = number(a, value());
+    else if (a == "--noise-mm" || a == "--camera-noise-mm") camera.noise_mm = number(a, value());
     else if (a == "--resolution-mm") resolution_mm = number(a, value());
     else if (a == "--dropout") dropout = number(a, value());
     else if (a == "--seed") camera.seed = static_cast<std::uint64_t>(whole(a, value(), 0, 1LL << 62));

@@ -137,7 +137,7 @@ struct EmulatorServer::Impl {
         return;
       default: break;
     }
-    if (r.command != Command::kStatus) {
+    if (r.command != Command::kStatus && r.command != Command::kTruth) {
       if (options.drop_after >= 0 && !dropped_once && counted == options.drop_after) {
         dropped_once = true;
         return close(c);

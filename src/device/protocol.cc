@@ -212,6 +212,7 @@ std::string format_request(const Request& r) {
     case Command::kStatus: return out + "status";
     case Command::kCapture: return out + "capture";
     case Command::kVent: return out + "vent";
+    case Command::kTruth: return out + "truth";
     case Command::kAction:
       out += r.action.op_name();
       if (r.action.op == Action::Op::kSetPressure) return out + ' ' + format_double(r.action.pressure_pa);
@@ -246,12 +247,14 @@ Request parse_request(std::string_view line) {
     r.action.a = int_argument(r.id, words[2], first, lo, 1'000'000);
     r.action.b = int_argument(r.id, words[3], second, lo, 1'000'000);
   };
-  if (name == "hello" || name == "ping" || name == "status" || name == "capture" || name == "vent") {
+  if (name == "hello" || name == "ping" || name == "status" || name == "capture" || name == "vent" ||
+      name == "truth") {
     expect_arguments(r.id, words, 0, "");
-    r.command = name == "hello"    ? Command::kHello
-                : name == "ping"   ? Command::kPing
-                : name == "status" ? Command::kStatus
+    r.command = name == "hello"     ? Command::kHello
+                : name == "ping"    ? Command::kPing
+                : name == "status"  ? Command::kStatus
                 : name == "capture" ? Command::kCapture
+                : name == "truth"   ? Command::kTruth
                                     : Command::kVent;
   } else if (name == "set_pressure") {
     expect_arguments(r.id, words, 1, "PA");
@@ -283,8 +286,8 @@ Request parse_request(std::string_view line) {
   } else {
     throw ProtocolError(ErrorCode::kUnknownCommand, r.id,
                         "unknown command " + quote(name) +
-                            ": expected hello, ping, status, capture, vent, set_pressure, jam, unjam, pin, unpin "
-                            "or fault");
+                            ": expected hello, ping, status, capture, vent, set_pressure, jam, unjam, pin, unpin, "
+                            "fault or truth");
   }
   return r;
 }

@@ -43,7 +43,9 @@ class ProtocolError : public std::runtime_error {
   std::uint64_t id_;
 };
 
-enum class Command { kHello, kPing, kStatus, kCapture, kVent, kAction, kFault };
+// kTruth is the emulator's test hook: the true surface, not what its camera
+// reports (PROTOCOL.md, "The true surface").
+enum class Command { kHello, kPing, kStatus, kCapture, kVent, kAction, kFault, kTruth };
 
 // Test hooks of the emulator (PROTOCOL.md, "Faults").
 struct Fault {

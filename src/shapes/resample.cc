@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -69,22 +70,8 @@ void fill_from_nearest(const Eigen::MatrixXd& z, const Eigen::MatrixXd& weight, 
   }
 }
 
-}  // namespace
-
-double default_relief_mm(const ArrayGeometry& geometry) {
-  return kReliefPerShortSide * std::min(geometry.rows, geometry.cols) * geometry.cell_size_m * 1000.0;
-}
-
-double relief_or_default_mm(double requested_mm, const ArrayGeometry& geometry) {
-  return requested_mm > 0.0 ? requested_mm : default_relief_mm(geometry);
-}
-
-Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh) {
-  return resample_to_mesh(goal, mesh, default_relief_mm(mesh.geometry()));
-}
-
-Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh, double max_height_mm) {
-  check_goal(goal, max_height_mm);
+// The goal's area-weighted mean over each point's footprint, in its own units.
+Eigen::MatrixXd average_to_mesh(const HeightMap& goal, const Mesh& mesh) {
   // (rows x cols), row 0 = top; NaN that means "floor" becomes that height.
   const Eigen::MatrixXd z = goal.uncovered_height
                                 ? Eigen::MatrixXd(goal.z.array().isNaN().select(*goal.uncovered_height, goal.z.array()))
@@ -117,11 +104,68 @@ Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh, double
   }
   Eigen::MatrixXd value = (weight.array() > 0.0).select(sum.array() / weight.array(), 0.0);
   if ((weight.array() <= 0.0).any()) fill_from_nearest(z, weight, value);
+  return value;
+}
 
+}  // namespace
+
+double default_relief_mm(const ArrayGeometry& geometry) {
+  return kReliefPerShortSide * std::min(geometry.rows, geometry.cols) * geometry.cell_size_m * 1000.0;
+}
+
+double relief_or_default_mm(double requested_mm, const ArrayGeometry& geometry) {
+  return requested_mm > 0.0 ? requested_mm : default_relief_mm(geometry);
+}
+
+Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh, double max_height_mm) {
+  check_goal(goal, max_height_mm);
+  const Eigen::MatrixXd value = average_to_mesh(goal, mesh);
+  const int n_i = mesh.point_rows(), n_j = mesh.point_cols();
   // Lowest point 0, highest max_height_mm.
   const double lo = value.minCoeff(), hi = value.maxCoeff();
   if (hi - lo <= 1e-12 * std::max({1.0, std::abs(lo), std::abs(hi)})) return Eigen::MatrixXd::Zero(n_i, n_j);
   return (value.array() - lo) * (max_height_mm / (hi - lo));
+}
+
+Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh) {
+  return resample_to_mesh(goal, mesh, default_relief_mm(mesh.geometry()));
+}
+
+GoalHeights parse_goal_heights(const std::string& name) {
+  if (name == "scaled") return GoalHeights::kScaled;
+  if (name == "absolute") return GoalHeights::kAbsolute;
+  throw std::invalid_argument("unknown goal heights \"" + name + "\"; known: scaled (stretched to the relief), absolute (mm)");
+}
+
+void check_absolute_goal_format(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".csv" && ext != ".tif" && ext != ".tiff")
+    throw std::invalid_argument("goal \"" + file.string() + "\": absolute heights (mm) need a CSV or float TIFF " +
+                                "height goal, not \"" + ext + "\" (its values are not millimetres)");
+}
+
+Eigen::MatrixXd absolute_to_mesh(const HeightMap& goal, const Mesh& mesh) {
+  check_goal(goal, 1.0);
+  const int n_i = mesh.point_rows(), n_j = mesh.point_cols();
+  if (goal.z.rows() != n_i || goal.z.cols() != n_j) return average_to_mesh(goal, mesh);
+  // One value per mesh point; the image's top row is the mesh's last.
+  Eigen::MatrixXd value(n_i, n_j);
+  for (int i = 0; i < n_i; ++i)
+    for (int j = 0; j < n_j; ++j) {
+      const long r = n_i - 1 - i;
+      const double v = goal.uncovered_height && std::isnan(goal.z(r, j)) ? *goal.uncovered_height : goal.z(r, j);
+      if (std::isnan(v))
+        throw std::invalid_argument("goal \"" + goal.source + "\" at the mesh points (absolute heights): row " +
+                                    std::to_string(r) + ", column " + std::to_string(j) + " is NaN");
+      value(i, j) = v;
+    }
+  return value;
+}
+
+Eigen::MatrixXd goal_to_mesh(const HeightMap& goal, const Mesh& mesh, GoalHeights heights, double max_height_mm) {
+  if (heights == GoalHeights::kAbsolute) return absolute_to_mesh(goal, mesh);
+  return resample_to_mesh(goal, mesh, relief_or_default_mm(max_height_mm, mesh.geometry()));
 }
 
 }  // namespace hj

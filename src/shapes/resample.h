@@ -4,6 +4,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
+#include <string>
 
 #include "model/mesh.h"
 #include "shapes/height_map.h"
@@ -34,5 +36,28 @@ double relief_or_default_mm(double requested_mm, const ArrayGeometry& geometry);
 Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh, double max_height_mm);
 // The same at the array's default relief.
 Eigen::MatrixXd resample_to_mesh(const HeightMap& goal, const Mesh& mesh);
+
+// How a goal's values become heights on the display: stretched to a relief
+// (resample_to_mesh), or taken at face value as mm above the plane of the
+// clamped edge (negative allowed), for a user who knows the surface.
+enum class GoalHeights { kScaled, kAbsolute };
+// "scaled" or "absolute"; std::invalid_argument otherwise.
+GoalHeights parse_goal_heights(const std::string& name);
+
+// Absolute heights are for goals whose values are mm: a CSV or a (float)
+// TIFF. @throws std::invalid_argument naming the file for another format.
+void check_absolute_goal_format(const std::filesystem::path& file);
+
+// The goal at face value, mm per mesh point, not rescaled. A goal of exactly
+// (R p + 1) x (C p + 1) values is the goal at the mesh points (row 0 = the
+// top, i.e. mesh row R p, as for any image); any other size is area-averaged
+// as resample_to_mesh does, without the scaling.
+// @throws std::invalid_argument as resample_to_mesh, and for a NaN value in
+//         a goal given at the mesh points (naming its row and column).
+Eigen::MatrixXd absolute_to_mesh(const HeightMap& goal, const Mesh& mesh);
+
+// The goal per mesh point as `heights` says (max_height_mm only for kScaled,
+// 0 = the array's default relief).
+Eigen::MatrixXd goal_to_mesh(const HeightMap& goal, const Mesh& mesh, GoalHeights heights, double max_height_mm);
 
 }  // namespace hj

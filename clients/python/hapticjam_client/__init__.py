@@ -9,7 +9,8 @@ put that folder and clients/python on PYTHONPATH:
 
 try:
     from hapticjam.v1 import (array_pb2, device_service_pb2, device_service_pb2_grpc, goal_pb2, plan_pb2,
-                              planning_service_pb2, planning_service_pb2_grpc, surface_pb2)
+                              planning_service_pb2, planning_service_pb2_grpc, render_service_pb2,
+                              render_service_pb2_grpc, surface_pb2)
 except ImportError as e:  # pragma: no cover - a message a user can act on
     raise ImportError(
         "hapticjam_client needs the generated stubs: build them (cmake --build build --target hj_python_stubs) "
@@ -20,4 +21,4 @@ from .surface import Surface, write_png
 
 __all__ = ["Client", "ClientError", "Surface", "dataset_upload", "file_goal", "map_goal", "write_png", "array_pb2",
            "device_service_pb2", "device_service_pb2_grpc", "goal_pb2", "plan_pb2", "planning_service_pb2",
-           "planning_service_pb2_grpc", "surface_pb2"]
+           "planning_service_pb2_grpc", "render_service_pb2", "render_service_pb2_grpc", "surface_pb2"]

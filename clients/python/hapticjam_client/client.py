@@ -9,7 +9,7 @@ import os
 import grpc
 from hapticjam.v1 import (array_pb2, calibration_service_pb2, calibration_service_pb2_grpc, device_service_pb2,
                           device_service_pb2_grpc, goal_pb2, plan_pb2, planning_service_pb2,
-                          planning_service_pb2_grpc)
+                          planning_service_pb2_grpc, render_service_pb2, render_service_pb2_grpc)
 
 # Goals (meshes, DEMs) may exceed gRPC's 4 MiB default; the server takes up to 64 MiB.
 MAX_MESSAGE_BYTES = 64 << 20
@@ -29,13 +29,18 @@ class ClientError(Exception):
         super().__init__(f"{call}: {self.code.name}: {self.details}")
 
 
-def file_goal(path, region=None, max_height_mm=0.0, up_axis="", hue=False, view_resolution=0):
+def file_goal(path, region=None, max_height_mm=0.0, up_axis="", hue=False, view_resolution=0, absolute=False):
     """A Goal from a file's bytes (the format follows its extension).
-    region: (x0, y0, x1, y1), fractions of the image, or pixels if any exceeds 1."""
+    region: (x0, y0, x1, y1), fractions of the image, or pixels if any exceeds 1.
+    absolute: a CSV or float TIFF taken as mm above the clamped edge's plane
+    (not rescaled; (R p + 1) x (C p + 1) values are the goal at the mesh points)."""
     with open(path, "rb") as f:
         content = f.read()
     goal = goal_pb2.Goal(file=goal_pb2.GoalFile(content=content, file_name=os.path.basename(path)))
-    return _finish_goal(goal, region, max_height_mm, up_axis, hue, view_resolution)
+    goal = _finish_goal(goal, region, max_height_mm, up_axis, hue, view_resolution)
+    if absolute:
+        goal.options.heights = goal_pb2.GOAL_HEIGHTS_ABSOLUTE
+    return goal
 
 
 def map_goal(name, region=None, max_height_mm=0.0):
@@ -130,6 +135,7 @@ class Client:
         self.planning = planning_service_pb2_grpc.PlanningServiceStub(self.channel)
         self.device = device_service_pb2_grpc.DeviceServiceStub(self.channel)
         self.calibration = calibration_service_pb2_grpc.CalibrationServiceStub(self.channel)
+        self.rendering = render_service_pb2_grpc.RenderServiceStub(self.channel)
 
     def close(self):
         self.channel.close()
@@ -177,6 +183,38 @@ class Client:
         if result is None:
             raise RuntimeError("the server ended the plan stream without a result")
         return result, snapshots
+
+    # -- rendering --
+
+    def render(self, goal, rows, cols, segments=0, planner="", iterations=0, correction="targets", gain=0.0,
+               name="", on_event=None, timeout=None):
+        """Renders `goal` on the server's device with the loop closed (docs/render.md):
+        plan, run, capture, compare with the goal, correct the targets, again.
+        on_event(RenderEvent) sees every progress and iteration event.
+        correction: "targets" (learn the targets from the error) or "none" (open loop).
+        Returns (RenderResult, [RenderIteration, ...])."""
+        corrections = {"targets": render_service_pb2.RENDER_CORRECTION_TARGETS,
+                       "none": render_service_pb2.RENDER_CORRECTION_NONE}
+        if correction not in corrections:
+            raise ValueError(f"correction must be one of {sorted(corrections)}, got {correction!r}")
+        request = render_service_pb2.RenderRequest(array=array_spec(rows, cols, segments), goal=goal, planner=planner,
+                                                   iterations=iterations, correction=corrections[correction],
+                                                   gain=gain, name=name)
+        result, iterations_seen = None, []
+        try:
+            for event in self.rendering.Render(request, timeout=timeout, metadata=self.metadata):
+                if on_event:
+                    on_event(event)
+                kind = event.WhichOneof("event")
+                if kind == "iteration":
+                    iterations_seen.append(event.iteration)
+                elif kind == "result":
+                    result = event.result
+        except grpc.RpcError as e:
+            raise ClientError("Render", e) from None
+        if result is None:
+            raise RuntimeError("the server ended the render stream without a result")
+        return result, iterations_seen
 
     # -- calibration --
 

@@ -1,0 +1,232 @@
+#!/usr/bin/env python3
+"""The render job's acceptance figures (docs/render.md): device-makeable goals
+on an emulator whose model the planner was not given, closed loop against open
+loop, as a Markdown table.
+
+For each case it starts hapticjam-device-emulator with the case's params
+(effects the planner does not know, a finer mesh, a 1 mm camera), makes each
+goal with the emulator's own model from a known sequence (sent on a raw
+protocol line, read back with `truth` at the planner's mesh points, vented),
+starts hapticjam-server on it, runs `hapticjam remote render --json` and
+reads the true surface afterwards.
+
+  scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...]
+"""
+import argparse
+import json
+import os
+import re
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+CASES = {
+    "stiffening": {"stiffening": {"beta": 30}},
+    "soft-middle": {"cell_stiffness": {"bulge": -0.3}},
+    "both": {"stiffening": {"beta": 30}, "cell_stiffness": {"bulge": -0.3}},
+    "tilt": {"stiffening": {"beta": 30}, "sensor_tilt": {"tilt_x_mrad": 15, "tilt_y_mrad": -10}},
+}
+
+
+def sequences(rows, cols):
+    """Three known sequences per array size: rising pressure, jams and pins on the way.
+    Pressures are for 3 x 4; a larger array domes higher at the same pressure,
+    so they are scaled by (3 / rows)^2 (6 x 8: 1200 Pa -> 300 Pa)."""
+    r2, c2 = rows // 2, cols // 2
+    scale = (3.0 / rows) ** 2
+    return {name: [scaled(c, scale) for c in seq] for name, seq in {
+        "ridge": ["set_pressure 1200", "jam 0 1", f"pin 1 1", "set_pressure 2400", f"jam {rows - 2} {cols - 2}",
+                  f"jam {rows - 1} 0", "set_pressure 3000"],
+        "terrace": ["set_pressure 800"] + [f"jam 0 {c}" for c in range(cols)] +
+                   ["set_pressure 2000", f"pin {r2} {c2}", "set_pressure 3200"],
+        "saddle": ["set_pressure 1500", f"jam {r2} {c2}", f"jam 0 {cols - 1}", "set_pressure 2800",
+                   f"pin 1 {cols - 2}"],
+    }.items()}
+
+
+def scaled(command, scale):
+    words = command.split(" ")
+    return f"set_pressure {float(words[1]) * scale:g}" if words[0] == "set_pressure" else command
+
+
+class Line:
+    """A raw connection to the emulator (src/device/PROTOCOL.md)."""
+
+    def __init__(self, port):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=120)
+        self.sock.settimeout(0.2)
+        self.buffer = b""
+        self.id = 0
+        self.pings = 1 << 40  # ids of the heartbeat, apart from the commands'
+
+    def _receive(self):
+        """More bytes; a ping while waiting, so the emulator's watchdog sees a live line."""
+        try:
+            chunk = self.sock.recv(1 << 20)
+        except socket.timeout:
+            self.pings += 1
+            self.sock.sendall(f"{self.pings} ping\n".encode())
+            return
+        if not chunk:
+            raise RuntimeError("the emulator closed the line")
+        self.buffer += chunk
+
+    def request(self, command):
+        self.id += 1
+        self.sock.sendall(f"{self.id} {command}\n".encode())
+        while True:
+            nl = self.buffer.find(b"\n")
+            if nl >= 0:
+                line, self.buffer = self.buffer[:nl].decode(), self.buffer[nl + 1:]
+                if line.split(" ")[1:2] == [str(self.id)]:
+                    if not line.startswith("ok"):
+                        raise RuntimeError(f"{command}: {line}")
+                    return line[len(f"ok {self.id}"):].strip()
+                continue
+            self._receive()
+
+    def close(self):
+        self.sock.close()
+
+
+def at_mesh_points(payload, rows, cols, p, cell_mm=38.0):
+    """A `frame` payload bilinearly sampled at the rest points (row i along +y)."""
+    words = payload.split(" ")
+    nx, ny = int(words[1]), int(words[2])
+    x0, y0, dx, dy = map(float, words[3:7])
+    v = [float(s) for s in words[7].split(",")]
+    h = cell_mm / p
+    out = []
+    for i in range(rows * p + 1):
+        row = []
+        for j in range(cols * p + 1):
+            u, w = (j * h - x0) / dx, (i * h - y0) / dy
+            ix, iy = min(max(int(u), 0), nx - 2), min(max(int(w), 0), ny - 2)
+            fx, fy = min(max(u - ix, 0), 1), min(max(w - iy, 0), 1)
+            s = wt = 0.0
+            for ddy in (0, 1):
+                for ddx in (0, 1):
+                    z = v[(iy + ddy) * nx + ix + ddx]
+                    k = (fx if ddx else 1 - fx) * (fy if ddy else 1 - fy)
+                    if z == z and k > 0:
+                        s, wt = s + k * z, wt + k
+            row.append(s / wt if wt > 0 else float("nan"))
+        out.append(row)
+    return out
+
+
+def mae(a, b):
+    d = [abs(x - y) for ra, rb in zip(a, b) for x, y in zip(ra, rb) if x == x and y == y]
+    return sum(d) / len(d)
+
+
+def start(argv, pattern, log):
+    proc = subprocess.Popen(argv, stdout=open(log + ".out", "w"), stderr=open(log + ".err", "w"))
+    end = time.time() + 60
+    while time.time() < end:
+        m = re.search(pattern, open(log + ".out").read())
+        if m:
+            return proc, int(m.group(1))
+        if proc.poll() is not None:
+            break
+        time.sleep(0.05)
+    raise RuntimeError(f"{argv[0]} did not start: " + open(log + ".err").read())
+
+
+def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain):
+    rows, cols = size
+    params = os.path.join(work, "device.json")
+    with open(params, "w") as f:
+        json.dump({"format": "hapticjam.params/1", "effects": CASES[case]}, f)
+    emulator, port = start([os.path.join(build, "src/device/hapticjam-device-emulator"), "--listen", "127.0.0.1:0",
+                            "--rows", str(rows), "--cols", str(cols), "--segments", "8", "--params", params,
+                            "--noise-mm", str(noise), "--seed", "11"],
+                           r"listening on 127\.0\.0\.1:(\d+)", os.path.join(work, "emulator"))
+    server = None
+    try:
+        line = Line(port)
+        for c in commands:
+            line.request(c)
+        goal = at_mesh_points(line.request("truth"), rows, cols, 4)
+        line.request("vent")
+        goal_file = os.path.join(work, f"{goal_name}.csv")
+        with open(goal_file, "w") as f:
+            for row in reversed(goal):
+                f.write(",".join(repr(z) for z in row) + "\n")
+        db = os.path.join(work, "queue.db")
+        for suffix in ("", "-wal", "-shm", ".lock"):
+            if os.path.exists(db + suffix):
+                os.remove(db + suffix)
+        server, server_port = start([os.path.join(build, "server/hapticjam-server"), "--listen", "127.0.0.1:0",
+                                     "--db", db, "--device", f"127.0.0.1:{port}"],
+                                    r"listening on port (\d+)", os.path.join(work, "server"))
+        address = f"127.0.0.1:{server_port}"
+        cli = os.path.join(build, "hapticjam")
+        for _ in range(300):
+            status = subprocess.run([cli, "remote", "status", "--json", "--server", address] + (["--gain", str(gain)] if gain else []), capture_output=True,
+                                    text=True)
+            if status.returncode == 0 and json.loads(status.stdout).get("connected"):
+                break
+            time.sleep(0.1)
+        started = time.time()
+        render = subprocess.run([cli, "remote", "render", goal_file, "--rows", str(rows), "--cols", str(cols),
+                                 "--segments", "4", "--iterations", str(iterations), "--heights", "absolute",
+                                 "--json", "--server", address] + (["--gain", str(gain)] if gain else []), capture_output=True, text=True)
+        seconds = time.time() - started
+        if render.returncode != 0:
+            raise RuntimeError(f"render failed ({render.returncode}): {render.stderr}")
+        lines = [json.loads(s) for s in render.stdout.splitlines() if s.strip()]
+        truth = at_mesh_points(line.request("truth"), rows, cols, 4)
+        line.close()
+        return {"iterations": lines[:-1], "result": lines[-1]["result"], "true_mae_mm": mae(goal, truth),
+                "seconds": seconds}
+    finally:
+        for proc in (server, emulator):
+            if proc:
+                proc.terminate()
+                proc.wait()
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--sizes", default="3x4,6x8")
+    ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--goals", default="ridge,terrace,saddle")
+    ap.add_argument("--iterations", type=int, default=5)
+    ap.add_argument("--noise-mm", type=float, default=1.0)
+    ap.add_argument("--gain", type=float, default=0.0, help="of the target correction (0: the server's default)")
+    ap.add_argument("--json-out", help="also write every run's figures here")
+    args = ap.parse_args()
+    runs = []
+    print("| array | device | goal | open loop MAE (mm) | closed loop MAE (mm) | r open / closed | below open loop | "
+          "iterations (best) | true surface MAE (mm) | render (s) |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for size_text in args.sizes.split(","):
+        size = tuple(int(v) for v in size_text.split("x"))
+        for case in args.cases.split(","):
+            for goal_name in args.goals.split(","):
+                with tempfile.TemporaryDirectory(prefix="hj_render_") as work:
+                    try:
+                        run = run_case(args.build, work, case, size, goal_name, sequences(*size)[goal_name],
+                                       args.iterations, args.noise_mm, args.gain)
+                    except RuntimeError as e:
+                        print(f"| {size_text} | {case} | {goal_name} | failed: {e} |||||||", flush=True)
+                        continue
+                r = run["result"]
+                below = 100.0 * (1 - r["mae_mm"] / r["open_loop_mae_mm"]) if r["open_loop_mae_mm"] > 0 else 0.0
+                corr = lambda v: "-" if v is None else f"{v:.3f}"
+                print(f"| {size_text} | {case} | {goal_name} | {r['open_loop_mae_mm']:.2f} | {r['mae_mm']:.2f} | "
+                      f"{corr(r.get('open_loop_correlation'))} / {corr(r['correlation'])} | {below:.0f} % | "
+                      f"{r['iterations']} ({r['best_iteration']}) | {run['true_mae_mm']:.2f} | {run['seconds']:.0f} |",
+                      flush=True)
+                runs.append({"size": size_text, "case": case, "goal": goal_name, **run})
+    if args.json_out:
+        with open(args.json_out, "w") as f:
+            json.dump(runs, f, indent=1)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,249 @@
+#include "render_loop.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "calib/rasterize.h"
+#include "json_log.h"
+#include "metrics/height_error.h"
+#include "plan/planner.h"
+#include "service_error.h"
+
+namespace hj::server {
+
+namespace v1 = ::hapticjam::v1;
+using Clock = std::chrono::steady_clock;
+using grpc::StatusCode;
+
+namespace {
+
+// An iteration must beat the best so far by this share of its error, or the
+// error has stopped falling (camera noise moves it by about this much).
+constexpr double kMinImprovement = 0.02;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+void add_heights(const Eigen::MatrixXd& m, google::protobuf::RepeatedField<double>* out) {
+  out->Reserve(int(m.size()));
+  for (int i = 0; i < m.rows(); ++i)
+    for (int j = 0; j < m.cols(); ++j) out->Add(m(i, j));
+}
+
+void error_to_proto(const HeightError& e, v1::SurfaceError* out) {
+  out->set_mae_mm(e.mae_mm);
+  out->set_rmse_mm(e.rmse_mm);
+  if (e.correlation.value) out->set_correlation(*e.correlation.value);
+  out->set_points(e.points);
+}
+
+FrameGrid frame_grid(const v1::CaptureGrid& g) { return {g.nx(), g.ny(), g.x0_mm(), g.y0_mm(), g.dx_mm(), g.dy_mm()}; }
+
+Eigen::MatrixXd frame_heights(const v1::CaptureFrame& frame) {
+  const int nx = frame.grid().nx(), ny = frame.grid().ny();
+  if (nx < 1 || ny < 1 || frame.heights_mm_size() != nx * ny)
+    throw ServiceError(StatusCode::INTERNAL, "the device returned a capture of " +
+                                                 std::to_string(frame.heights_mm_size()) + " samples for a grid of " +
+                                                 std::to_string(nx) + " x " + std::to_string(ny));
+  Eigen::MatrixXd out(ny, nx);
+  for (int iy = 0; iy < ny; ++iy)
+    for (int ix = 0; ix < nx; ++ix) out(iy, ix) = frame.heights_mm(iy * nx + ix);
+  return out;
+}
+
+// The predicted surface as the camera would see it at the rest points: like with like.
+Eigen::MatrixXd predicted_at_rest_points(const Mesh& mesh, const Eigen::Matrix3Xd& x, const v1::CaptureGrid& g) {
+  SessionGrid grid;
+  grid.nx = g.nx(), grid.ny = g.ny(), grid.x0_mm = g.x0_mm(), grid.y0_mm = g.y0_mm();
+  grid.dx_mm = g.dx_mm(), grid.dy_mm = g.dy_mm();
+  return frame_at_rest_points(mesh, rasterize_top_view(mesh, x, grid), frame_grid(g));
+}
+
+class RenderRun {
+ public:
+  RenderRun(const RenderSetup& setup, DeviceQueue& queue, const Caller& caller, const RenderHooks& hooks)
+      : setup_(setup), queue_(queue), caller_(caller), hooks_(hooks), mesh_(setup.array.geometry),
+        targets_(setup.goal_mm) {}
+
+  v1::RenderResult run() {
+    check_device();
+    const auto start = Clock::now();
+    v1::RenderResult result;
+    result.set_point_rows(mesh_.point_rows()), result.set_point_cols(mesh_.point_cols());
+    add_heights(setup_.goal_mm, result.mutable_goal_heights_mm());
+    double best_mae = INFINITY;
+    std::string stop = "the iteration limit (" + std::to_string(setup_.iterations) + ")";
+    for (int i = 1; i <= setup_.iterations; ++i) {
+      v1::RenderIteration it = iterate(i);
+      result.add_job_ids(it.job_id());
+      result.set_iterations(i);
+      if (i == 1) *result.mutable_open_loop_error() = it.error();
+      const double mae = it.error().mae_mm();
+      const bool improved = mae < best_mae * (1.0 - kMinImprovement);
+      if (mae < best_mae) {
+        best_mae = mae;
+        result.set_best_iteration(i);
+        *result.mutable_error() = it.error();
+      }
+      const bool last = i == setup_.iterations;
+      if (!improved && i > 1) stop = "the error stopped falling (iteration " + std::to_string(i) + ")";
+      const bool stopping = last || (!improved && i > 1);
+      if (stopping) it.set_correction("none: the render ends here");
+      emit_iteration(std::move(it));
+      if (stopping) break;
+    }
+    result.set_stop_reason(stop);
+    result.set_seconds(seconds_since(start));
+    return result;
+  }
+
+ private:
+  void check_device() {
+    const v1::DeviceStatus status = queue_.device_status();
+    const ArrayGeometry& g = setup_.array.geometry;
+    if (status.connected() && (status.rows() != g.rows || status.cols() != g.cols))
+      throw ServiceError(StatusCode::FAILED_PRECONDITION,
+                         "the device is a " + std::to_string(status.rows()) + " x " + std::to_string(status.cols()) +
+                             " array; the render asks for " + std::to_string(g.rows) + " x " + std::to_string(g.cols));
+  }
+
+  void progress(int iteration, double within, const std::string& what) {
+    v1::RenderEvent event;
+    v1::RenderProgress* p = event.mutable_progress();
+    p->set_iteration(iteration);
+    p->set_fraction(std::clamp((iteration - 1 + within) / setup_.iterations, 0.0, 1.0));
+    p->set_message(what);
+    hooks_.emit(std::move(event));
+  }
+
+  void emit_iteration(v1::RenderIteration it) {
+    v1::RenderEvent event;
+    *event.mutable_iteration() = std::move(it);
+    hooks_.emit(std::move(event));
+  }
+
+  PlanResult plan(int iteration) {
+    PlanRequest request{setup_.array.geometry, setup_.array.params, targets_, setup_.array.simulator, {}};
+    PlanCallbacks callbacks;
+    callbacks.cancelled = hooks_.cancelled;
+    callbacks.progress = [&](double fraction, const std::string& what) {
+      progress(iteration, 0.5 * fraction, "planning: " + what);
+    };
+    try {
+      return make_planner(setup_.planner)->plan(request, callbacks);
+    } catch (const PlanCancelled&) {
+      throw ServiceError(StatusCode::CANCELLED, "the render was cancelled while planning iteration " +
+                                                    std::to_string(iteration));
+    }
+  }
+
+  // Submits the plan and a capture; waits for the job to end; its capture.
+  v1::Job run_on_device(int iteration, const PlanResult& planned, v1::Plan* plan) {
+    for (const Action& a : planned.steps) action_to_proto(a, plan->add_steps());
+    plan->set_planner(setup_.planner);
+    v1::Plan with_capture = *plan;
+    v1::Step* capture = with_capture.add_steps();
+    capture->mutable_capture();
+    capture->set_label(setup_.name + " iteration " + std::to_string(iteration));
+    const v1::Job queued = queue_.submit(caller_, setup_.name + " iteration " + std::to_string(iteration), with_capture);
+    log_event("render_job", {{"job", queued.id()}, {"iteration", iteration}});
+    std::uint64_t seen = 0;
+    bool cancel_sent = false;
+    for (;;) {
+      v1::Job job = queue_.get(queued.id());
+      if (is_finished(job.state())) return job;
+      if (!cancel_sent && hooks_.cancelled()) {
+        cancel_sent = true;
+        try {
+          queue_.cancel(caller_, queued.id());
+        } catch (const ServiceError&) {
+          // It ended meanwhile: the next get() says how.
+        }
+      }
+      progress(iteration, 0.5 + 0.5 * job.steps_done() / std::max(1, job.steps_total()),
+               "on the device: step " + std::to_string(job.steps_done()) + " of " + std::to_string(job.steps_total()) +
+                   (job.position() > 0 ? " (position " + std::to_string(job.position()) + " in the queue)" : ""));
+      seen = queue_.wait_for_change(seen, std::chrono::milliseconds(200));
+      if (queue_.stopping()) throw ServiceError(StatusCode::UNAVAILABLE, "the server is shutting down");
+    }
+  }
+
+  v1::RenderIteration iterate(int i) {
+    v1::RenderIteration it;
+    it.set_iteration(i);
+    const auto planning_start = Clock::now();
+    const PlanResult planned = plan(i);
+    it.set_planning_seconds(seconds_since(planning_start));
+
+    const auto device_start = Clock::now();
+    const v1::Job job = run_on_device(i, planned, it.mutable_plan());
+    it.set_device_seconds(seconds_since(device_start));
+    it.set_job_id(job.id());
+    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() == 0) {
+      const bool cancelled = job.state() == v1::JOB_STATE_CANCELLED && hooks_.cancelled();
+      throw ServiceError(cancelled ? StatusCode::CANCELLED : StatusCode::ABORTED,
+                         "render iteration " + std::to_string(i) + ": device job " + std::to_string(job.id()) +
+                             " ended " + v1::JobState_Name(job.state()) +
+                             (job.error().empty() ? std::string() : ": " + job.error()));
+    }
+    *it.mutable_capture() = job.captures(job.captures_size() - 1);
+
+    const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame_heights(it.capture()), frame_grid(it.capture().grid()));
+    const Eigen::MatrixXd measured = setup_.keep_camera_plane ? seen : calibrated(i, seen, it.mutable_camera());
+    const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, planned.final_state.x, it.capture().grid());
+    it.set_point_rows(mesh_.point_rows()), it.set_point_cols(mesh_.point_cols());
+    add_heights(measured, it.mutable_measured_heights_mm());
+    add_heights(predicted, it.mutable_predicted_heights_mm());
+    add_heights(targets_, it.mutable_target_heights_mm());
+    try {
+      error_to_proto(height_error(setup_.goal_mm, measured), it.mutable_error());
+      error_to_proto(height_error(predicted, measured), it.mutable_prediction_error());
+    } catch (const std::invalid_argument& e) {
+      throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
+    }
+    it.set_correction(correct(measured));
+    return it;
+  }
+
+  // The capture with the camera's plane (fitted on the clamped edge) taken out.
+  Eigen::MatrixXd calibrated(int i, const Eigen::MatrixXd& seen, v1::CameraPlane* out) {
+    CameraPlane plane;
+    try {
+      plane = fit_camera_plane(mesh_, seen);
+    } catch (const std::invalid_argument& e) {
+      throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
+    }
+    out->set_tilt_x_mrad(plane.tilt_x_mrad), out->set_tilt_y_mrad(plane.tilt_y_mrad);
+    out->set_offset_mm(plane.offset_mm), out->set_points(plane.points);
+    return without_camera_plane(mesh_, seen, plane);
+  }
+
+  // The next iteration's targets; what changed, for people.
+  std::string correct(const Eigen::MatrixXd& measured) {
+    if (setup_.correction == v1::RENDER_CORRECTION_NONE) return "none (open loop: the same targets again)";
+    const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, measured, setup_.gain);
+    const Eigen::ArrayXXd change = (next - targets_).array().abs();
+    targets_ = next;
+    std::ostringstream s;
+    s.precision(3);
+    s << "targets += " << setup_.gain << " x (goal - measured): mean |change| " << change.mean() << " mm, max "
+      << change.maxCoeff() << " mm";
+    return s.str();
+  }
+
+  const RenderSetup& setup_;
+  DeviceQueue& queue_;
+  const Caller& caller_;
+  const RenderHooks& hooks_;
+  const Mesh mesh_;
+  Eigen::MatrixXd targets_;
+};
+
+}  // namespace
+
+v1::RenderResult run_render(const RenderSetup& setup, DeviceQueue& queue, const Caller& caller,
+                            const RenderHooks& hooks) {
+  return RenderRun(setup, queue, caller, hooks).run();
+}
+
+}  // namespace hj::server

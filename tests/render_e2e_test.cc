@@ -1,0 +1,130 @@
+// The render job end to end: the real hapticjam-server and a real
+// hapticjam-device-emulator whose model the planner was not given
+// (stiffening and a soft middle, a finer mesh, a noisy camera), on loopback,
+// driven by `hapticjam remote render --json`. The goal is one the device can
+// make (its own surface after a known sequence), so the loop can reach it.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "render_support.h"
+#include "scratch_dir.h"
+
+namespace hj {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using testing_support::EmulatorLine;
+using testing_support::wait_until;
+
+// A device the planner's baseline model does not know.
+const char* const kUnknownDevice = R"({"format": "hapticjam.params/1",
+  "effects": {"stiffening": {"beta": 30}, "cell_stiffness": {"bulge": -0.3}}})";
+
+const std::vector<std::string> kKnownSequence = {"set_pressure 1200", "jam 0 1", "pin 1 1", "set_pressure 2400",
+                                                 "jam 1 2", "jam 2 0", "set_pressure 3000"};
+
+struct RenderRig {
+  RenderRig() {
+    std::ofstream(dir.path / "device.json") << kUnknownDevice;
+    emulator = std::make_unique<testing_support::Emulator>(
+        dir.path, std::vector<std::string>{"--params", (dir.path / "device.json").string(), "--segments", "8",
+                                           "--noise-mm", "1", "--seed", "7"});
+    goal = testing_support::make_goal(emulator->port, mesh, kKnownSequence, dir.path / "goal.csv");
+    server = std::make_unique<testing_support::Server>(
+        dir.path, dir.path / "queue.db", std::vector<std::string>{"--device", emulator->endpoint()});
+  }
+  testing_support::CliResult cli(std::vector<std::string> args) {
+    args.insert(args.begin(), "remote");
+    args.insert(args.end(), {"--server", server->address()});
+    return testing_support::run_cli(args, dir.path);
+  }
+  bool connected() {
+    const auto r = cli({"status", "--json"});
+    return r.code == 0 && json::parse(r.out).value("connected", false);
+  }
+
+  testing_support::ScratchDir dir;
+  const Mesh mesh{ArrayGeometry{3, 4, 0.038, 4}};  // the planner's mesh
+  Eigen::MatrixXd goal;
+  std::unique_ptr<testing_support::Emulator> emulator;
+  std::unique_ptr<testing_support::Server> server;
+};
+
+std::vector<json> json_lines(const std::string& text) {
+  std::vector<json> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(json::parse(line));
+  return out;
+}
+
+TEST(RenderE2e, TheErrorFallsFromTheFirstIterationToTheLastAndTheTrueSurfaceImproves) {
+  RenderRig rig;
+  ASSERT_TRUE(wait_until([&] { return rig.connected(); })) << rig.server->process->err();
+  const auto r = rig.cli({"render", (rig.dir.path / "goal.csv").string(), "--rows", "3", "--cols", "4",
+                          "--segments", "4", "--iterations", "3", "--heights", "absolute", "--json", "--out",
+                          (rig.dir.path / "render").string()});
+  ASSERT_EQ(r.code, 0) << r.err << rig.server->process->err();
+  const auto lines = json_lines(r.out);
+  ASSERT_GE(lines.size(), 3u) << r.out;  // at least two iterations and the result
+  const json& first = lines.front();
+  const json& last = lines[lines.size() - 2];
+  const json& result = lines.back()["result"];
+  for (const char* key : {"iteration", "mae_mm", "rmse_mm", "correlation", "correction"})
+    EXPECT_TRUE(first.contains(key)) << key << " missing in " << first;
+  for (const char* key : {"iterations", "mae_mm", "rmse_mm", "correlation", "open_loop_mae_mm"})
+    EXPECT_TRUE(result.contains(key)) << key << " missing in " << result;
+  EXPECT_EQ(first["iteration"], 1);
+  EXPECT_LT(last["mae_mm"].get<double>(), first["mae_mm"].get<double>()) << r.out;
+  EXPECT_DOUBLE_EQ(result["open_loop_mae_mm"].get<double>(), first["mae_mm"].get<double>());
+  EXPECT_LE(result["mae_mm"].get<double>(), last["mae_mm"].get<double>());
+  EXPECT_TRUE(fs::exists(rig.dir.path / "render" / "iteration-1" / "capture.csv"));
+  EXPECT_TRUE(fs::exists(rig.dir.path / "render" / "result.json"));
+
+  // The device now holds the last iteration: its true surface (no camera
+  // noise) is nearer the goal than the open-loop plan's picture was.
+  EmulatorLine line(rig.emulator->port);
+  const HeightError truth = height_error(rig.goal, testing_support::true_surface(line, rig.mesh));
+  EXPECT_LT(truth.mae_mm, first["mae_mm"].get<double>());
+}
+
+TEST(RenderE2e, AnArraySizeOtherThanTheDevicesIsRefusedBeforeAnythingRuns) {
+  RenderRig rig;
+  ASSERT_TRUE(wait_until([&] { return rig.connected(); })) << rig.server->process->err();
+  const auto r = rig.cli({"render", (rig.dir.path / "goal.csv").string(), "--rows", "2", "--cols", "4",
+                          "--heights", "absolute", "--json"});
+  EXPECT_EQ(r.code, 19) << r.err;  // FAILED_PRECONDITION
+  EXPECT_NE(r.err.find("3 x 4"), std::string::npos) << r.err;
+}
+
+// An emergency stop during an iteration's job ends the render (ABORTED,
+// naming the job), and the queue stays paused: nothing of the render runs on.
+TEST(RenderE2e, AnEmergencyStopMidLoopEndsTheRender) {
+  RenderRig rig;
+  ASSERT_TRUE(wait_until([&] { return rig.connected(); })) << rig.server->process->err();
+  // Hold the device's commands so the first job is surely running when the stop comes.
+  EmulatorLine line(rig.emulator->port);
+  line.request("fault stall 3000");
+  const std::string cli = std::string(HJ_CLI_PATH);
+  testing_support::Process render({cli, "remote", "render", (rig.dir.path / "goal.csv").string(), "--rows", "3",
+                                   "--cols", "4", "--iterations", "3", "--heights", "absolute", "--json", "--server",
+                                   rig.server->address()},
+                                  rig.dir.path / "render.out", rig.dir.path / "render.err");
+  ASSERT_TRUE(wait_until([&] {
+    const auto r = rig.cli({"watch", "--once", "--json"});
+    return r.code == 0 && r.out.find("JOB_STATE_RUNNING") != std::string::npos;
+  }, 120));
+  const auto stop = rig.cli({"stop", "--reason", "test"});
+  EXPECT_EQ(stop.code, 0) << stop.err;
+  EXPECT_EQ(render.wait(), 20) << render.err();  // 10 + ABORTED
+  EXPECT_NE(render.err().find("iteration 1"), std::string::npos) << render.err();
+  const auto status = rig.cli({"status", "--json"});
+  EXPECT_TRUE(json::parse(status.out).value("queue_paused", false)) << status.out;
+}
+
+}  // namespace
+}  // namespace hj
