@@ -10,7 +10,7 @@ protocol line, read back with `truth` at the planner's mesh points, vented),
 starts hapticjam-server on it, runs `hapticjam remote render --json` and
 reads the true surface afterwards.
 
-  scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...]
+  scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...] [--planner NAME]
 """
 import argparse
 import json
@@ -135,7 +135,7 @@ def start(argv, pattern, log):
     raise RuntimeError(f"{argv[0]} did not start: " + open(log + ".err").read())
 
 
-def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain):
+def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain, planner):
     rows, cols = size
     params = os.path.join(work, "device.json")
     with open(params, "w") as f:
@@ -173,7 +173,8 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
         started = time.time()
         render = subprocess.run([cli, "remote", "render", goal_file, "--rows", str(rows), "--cols", str(cols),
                                  "--segments", "4", "--iterations", str(iterations), "--heights", "absolute",
-                                 "--json", "--server", address] + (["--gain", str(gain)] if gain else []), capture_output=True, text=True)
+                                 "--json", "--server", address] + (["--gain", str(gain)] if gain else [])
+                                + (["--planner", planner] if planner else []), capture_output=True, text=True)
         seconds = time.time() - started
         if render.returncode != 0:
             raise RuntimeError(f"render failed ({render.returncode}): {render.stderr}")
@@ -196,6 +197,7 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--goals", default="ridge,terrace,saddle")
     ap.add_argument("--iterations", type=int, default=5)
+    ap.add_argument("--planner", default="", help="the server's planner for each iteration (default: the server's)")
     ap.add_argument("--noise-mm", type=float, default=1.0)
     ap.add_argument("--gain", type=float, default=0.0, help="of the target correction (0: the server's default)")
     ap.add_argument("--json-out", help="also write every run's figures here")
@@ -211,7 +213,7 @@ def main():
                 with tempfile.TemporaryDirectory(prefix="hj_render_") as work:
                     try:
                         run = run_case(args.build, work, case, size, goal_name, sequences(*size)[goal_name],
-                                       args.iterations, args.noise_mm, args.gain)
+                                       args.iterations, args.noise_mm, args.gain, args.planner)
                     except RuntimeError as e:
                         print(f"| {size_text} | {case} | {goal_name} | failed: {e} |||||||", flush=True)
                         continue
