@@ -13,6 +13,7 @@
 
 #include "calib/diagnosis.h"
 #include "calib/synthesize.h"
+#include "calib_synthetic.h"
 #include "scratch_dir.h"
 
 namespace hj {
@@ -21,53 +22,15 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-json session_json(const std::string& name, const json& steps) {
-  return {{"format", "hapticjam.session/1"},
-          {"name", name},
-          {"device", {{"rows", 3}, {"cols", 4}, {"cell_size_mm", 38.0}, {"max_pressure_kpa", 3.45}}},
-          {"sensor", {{"kind", "depth camera"}, {"resolution_mm", 1.0}, {"accuracy_mm", 1.0}}},
-          {"grid", {{"nx", 77}, {"ny", 58}, {"x0_mm", 0.0}, {"y0_mm", 0.0}, {"dx_mm", 2.0}, {"dy_mm", 2.0}}},
-          {"steps", steps}};
-}
-
-json capture(int k) { return {{"op", "capture"}, {"frame", "frames/00" + std::to_string(k) + ".csv"}}; }
-json pressure(double kpa) { return {{"op", "set_pressure"}, {"kpa", kpa}}; }
-
-// Two short sessions: an unjammed sweep through the levelling pressure
-// (about 0.29 kPa) to 2 kPa, and two jammed cells raised to 1.5 kPa.
-void write_sessions(const fs::path& dir) {
-  const std::pair<std::string, json> sessions[] = {
-      {"sweep", json::array({capture(0), pressure(0.2), capture(1), pressure(0.4), capture(2), pressure(1.0),
-                             capture(3), pressure(2.0), capture(4)})},
-      {"jammed", json::array({capture(0), pressure(0.6), {{"op", "jam"}, {"cell", {1, 1}}},
-                              {{"op", "jam"}, {"cell", {0, 2}}}, capture(1), pressure(1.5), capture(2)})},
-  };
-  for (const auto& [name, steps] : sessions) {
-    fs::create_directories(dir / name);
-    std::ofstream(dir / name / "session.json") << session_json(name, steps).dump(1);
-  }
-}
-
-// demo-baseline's true baseline (its README), not the paper's defaults.
-ModelParams true_baseline() {
-  ModelParams m;
-  m.surface.mass_kg = 0.52;
-  m.surface.spring_k = 58.0;
-  m.surface.kappa_jam = 4.2;
-  return m;
-}
-
 constexpr double kTiltX = 15.0, kTiltY = -10.0, kOffset = 1.5;  // mrad, mrad, mm
 
 Dataset synthetic(const fs::path& root, bool tilted) {
-  write_sessions(root / "sessions");
-  ModelParams truth = true_baseline();
+  ModelParams truth = testing_support::true_tiny_baseline();
   if (tilted) {
     truth.effects = {"sensor_tilt"};
     truth.effect_parameters["sensor_tilt"] = {{"tilt_x_mrad", kTiltX}, {"tilt_y_mrad", kTiltY}, {"offset_mm", kOffset}};
   }
-  synthesize_dataset(root / "sessions", root / "data", truth, SynthOptions{});
-  return read_dataset(root / "data");
+  return testing_support::synthesize_tiny(root, truth);
 }
 
 DiagnoseOptions three_candidates() {
@@ -159,7 +122,7 @@ TEST(CalibDiagnoseSynth, UncoveredSamplesArePredictedAtTheClampLevel) {
   c.heights_mm(0, 4) = NAN;  // missing: not a residual at all
   c.jammed.assign(12, false);
   m.captures = {c};
-  ModelParams params = true_baseline();
+  ModelParams params = testing_support::true_tiny_baseline();
   const Eigen::VectorXd r = session_residuals(m, params, fitting_replay({}));
   ASSERT_EQ(r.size(), 4);
   EXPECT_EQ(r[0], -3.0);  // outside the array
