@@ -37,7 +37,11 @@ Eigen::MatrixXd device_made_goal(const ArrayGeometry& g) {
 
 void expect_matches_device_made_goal(const ArrayGeometry& g) {
   const PlanRequest request{g, SurfaceParameters::paper_defaults(g), device_made_goal(g), {}, {}};
-  const PlanResult plan = Portfolio().plan(request);
+  // What the strategies can reach, so no time budget: the strategy that
+  // matches these goals can take longer than 5 x Algorithm 2's time.
+  PortfolioOptions unlimited;
+  unlimited.max_time_ratio = 0.0;
+  const PlanResult plan = Portfolio(unlimited).plan(request);
   const Mesh mesh(g);
   EXPECT_GT(plan_score(request, mesh, plan.final_state), 0.95) << plan.note;
   EXPECT_LT(replay_gap_m(request, plan), 1e-5);
@@ -66,6 +70,35 @@ TEST(Portfolio, IsNeverBelowAlgorithm2AndSaysWhatItChose) {
   EXPECT_NE(best.note.find("algorithm2"), std::string::npos) << best.note;
   EXPECT_GT(snapshots, 5);  // Algorithm 2's, streamed as it runs, then the chosen one
   EXPECT_LT(replay_gap_m(request, best), 1e-5);
+}
+
+TEST(Portfolio, StopsTheOtherStrategiesAtItsTimeBudget) {
+  // One thread runs Algorithm 2 first; a budget of a tiny fraction of its
+  // time is spent before any other strategy starts, so each is stopped.
+  const ArrayGeometry g{2, 3, 0.038, 4};
+  const PlanRequest request = volcano_request(g);
+  PortfolioOptions options;
+  options.threads = 1;
+  options.max_time_ratio = 1e-9;
+  const PlanResult best = Portfolio(options).plan(request);
+  const PlanResult paper = make_planner("algorithm2")->plan(request);
+  EXPECT_EQ(best.note.rfind("chose algorithm2;", 0), 0u) << best.note;
+  std::size_t stopped = 0;
+  for (std::size_t at = 0; (at = best.note.find("stopped at the time budget", at)) != std::string::npos; ++at) ++stopped;
+  EXPECT_EQ(stopped, Portfolio::strategies().size() - 1) << best.note;
+  EXPECT_EQ(best.steps.size(), paper.steps.size());
+  EXPECT_LT((best.final_state.x - paper.final_state.x).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(Portfolio, RefusesABadTimeBudget) {
+  for (double ratio : {-1.0, std::nan(""), double(INFINITY)}) {
+    PortfolioOptions options;
+    options.max_time_ratio = ratio;
+    EXPECT_THROW(options.validate(), std::invalid_argument) << ratio;
+  }
+  PortfolioOptions options;
+  options.min_budget_s = -1.0;
+  EXPECT_THROW(options.validate(), std::invalid_argument);
 }
 
 TEST(RefusedActions, ADeadEndIsRecordedAndThePlanFinishes) {

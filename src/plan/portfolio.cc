@@ -1,6 +1,8 @@
 #include "plan/portfolio.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -20,13 +22,46 @@ namespace {
 struct StrategyOutcome {
   std::optional<PlanResult> result;
   double score = -INFINITY;
+  double seconds = 0.0;
   std::string error;
+};
+
+using Clock = std::chrono::steady_clock;
+
+// The time the strategies after Algorithm 2 may take: none until Algorithm 2
+// has finished, then max_time_ratio times its time from the start.
+class StrategyBudget {
+ public:
+  StrategyBudget(const PortfolioOptions& options, Clock::time_point start) : options_(options), start_(start) {}
+  void algorithm2_took(double seconds) {
+    if (options_.max_time_ratio <= 0.0) return;
+    algorithm2_s_ = seconds;
+    limit_s_.store(std::max(options_.max_time_ratio * seconds, options_.min_budget_s));
+  }
+  bool spent() const { return elapsed_s() > limit_s_.load(); }
+  double elapsed_s() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+  std::string describe() const {
+    char text[120];
+    std::snprintf(text, sizeof text, "stopped at the time budget, %.3g s (%.3g x algorithm2's %.3g s)", limit_s_.load(),
+                  options_.max_time_ratio, algorithm2_s_);
+    return text;
+  }
+
+ private:
+  const PortfolioOptions& options_;
+  Clock::time_point start_;
+  double algorithm2_s_ = 0.0;  // written before limit_s_ is, read after it is
+  std::atomic<double> limit_s_{INFINITY};
 };
 
 }  // namespace
 
 void PortfolioOptions::validate() const {
   if (threads < 0) throw std::invalid_argument("PortfolioOptions.threads must be >= 0 (0: one per core)");
+  if (!(max_time_ratio >= 0.0) || !std::isfinite(max_time_ratio))
+    throw std::invalid_argument("PortfolioOptions.max_time_ratio must be a finite number >= 0 (0: no limit)");
+  if (!(min_budget_s >= 0.0) || !std::isfinite(min_budget_s))
+    throw std::invalid_argument("PortfolioOptions.min_budget_s must be a finite number >= 0");
 }
 
 Portfolio::Portfolio(PortfolioOptions options) : options_(options) { options_.validate(); }
@@ -50,10 +85,13 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
   std::exception_ptr cancelled;
   int finished = 0;
   std::atomic<std::size_t> next{0};
+  StrategyBudget budget(options_, Clock::now());
+  const auto user_cancelled = [&] { return callbacks.cancelled && callbacks.cancelled(); };
 
   const auto run = [&](std::size_t k) {
     PlanCallbacks own;
-    own.cancelled = callbacks.cancelled;
+    // Strategy 0 is Algorithm 2, which always runs to its end.
+    own.cancelled = [&, k] { return user_cancelled() || (k != 0 && budget.spent()); };
     // One strategy's snapshots stream as it goes, so a watcher sees the surface form.
     if (k == 0 && callbacks.snapshot)
       own.snapshot = [&](const DeviceState& state) {
@@ -61,15 +99,21 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
         callbacks.snapshot(state);
       };
     StrategyOutcome& out = outcomes[k];
+    const double started_s = budget.elapsed_s();
     try {
       out.result = list[k].second->plan(request, own);
       out.score = plan_score(request, mesh, out.result->final_state);
     } catch (const PlanCancelled&) {
-      const std::lock_guard<std::mutex> lock(mutex);
-      cancelled = std::current_exception();
+      if (user_cancelled()) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        cancelled = std::current_exception();
+      }
+      out.error = budget.describe();
     } catch (const std::exception& e) {
       out.error = e.what();
     }
+    out.seconds = budget.elapsed_s() - started_s;
+    if (k == 0 && out.result) budget.algorithm2_took(out.seconds);
     const std::lock_guard<std::mutex> lock(mutex);
     ++finished;
     if (callbacks.progress) callbacks.progress(double(finished) / double(n), list[k].first + " finished");
@@ -89,11 +133,12 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
   std::size_t best = n;
   std::string note = "strategies:";
   for (std::size_t k = 0; k < n; ++k) {
-    char line[160];
+    char line[200];
     if (outcomes[k].result)
-      std::snprintf(line, sizeof line, " %s %.4f", list[k].first.c_str(), outcomes[k].score);
+      std::snprintf(line, sizeof line, " %s %.4f in %.3g s", list[k].first.c_str(), outcomes[k].score,
+                    outcomes[k].seconds);
     else
-      std::snprintf(line, sizeof line, " %s failed (%.80s)", list[k].first.c_str(), outcomes[k].error.c_str());
+      std::snprintf(line, sizeof line, " %s failed (%.100s)", list[k].first.c_str(), outcomes[k].error.c_str());
     note += (k ? ";" : "") + std::string(line);
     if (outcomes[k].result && (best == n || outcomes[k].score > outcomes[best].score)) best = k;
   }
