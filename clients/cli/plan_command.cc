@@ -12,6 +12,7 @@
 #include "calib/step_json.h"
 #include "compare_image.h"
 #include "metrics/correlation.h"
+#include "metrics/error_breakdown.h"
 #include "metrics/laplace_predictor.h"
 #include "plan/planner.h"
 #include "plan/refused_json.h"
@@ -112,6 +113,14 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
   return out;
 }
 
+// Where the remaining error lies (metrics/error_breakdown.h).
+nlohmann::json error_breakdown_to_json(const ErrorBreakdown& b) {
+  nlohmann::json places = nlohmann::json::object();
+  for (const ErrorPlace& p : b.places)
+    places[p.name] = {{"error_share", p.error_share}, {"area_share", p.area_share}, {"rms_mm", p.rms_mm}};
+  return {{"rms_mm", b.rms_mm}, {"dominant", b.dominant()}, {"places", places}};
+}
+
 // Mesh point heights (row i along +y) as an image (row 0 at the top).
 Eigen::MatrixXd as_image(const Eigen::MatrixXd& points) { return points.colwise().reverse(); }
 
@@ -169,6 +178,7 @@ int plan(const PlanArgs& args) {
   if (!corr.value) doc["correlation_undefined"] = corr.undefined_reason;
   if (!result.note.empty()) doc["planner_note"] = result.note;
   doc["refused"] = refused_to_json(result.refused);
+  doc["error_breakdown"] = error_breakdown_to_json(error_breakdown(mesh, request.goal_mm, predicted_mm));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Where the time went: the settles kept, the dead ends refused, the rest (import, rest state, files).
   doc["seconds"] = {{"total", seconds}, {"settles_kept", result.settle_seconds}, {"settles_refused", result.refused_seconds}};
