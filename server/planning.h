@@ -8,6 +8,7 @@
 #include <string>
 
 #include "metrics/correlation.h"
+#include "plan/default_planner.h"
 #include "plan/planner.h"
 #include "proto_convert.h"
 #include "shapes/height_map.h"
@@ -19,7 +20,7 @@ struct PlanningInput {
   ArrayConfig array;
   HeightMap goal;
   double max_height_mm = 0.0;  // 0: the array's default relief
-  std::string planner = "algorithm2";
+  std::string planner = kDefaultPlanner;
   GoalHeights heights = GoalHeights::kScaled;
 };
 

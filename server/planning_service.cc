@@ -43,7 +43,7 @@ std::shared_ptr<const v1::PlanResult> result_to_proto(const Mesh& mesh, const Pl
 // The request with defaults filled in, as the cache key's content.
 std::string cache_key(const v1::PreviewRequest& request) {
   v1::PreviewRequest canonical = request;
-  if (canonical.planner().empty()) canonical.set_planner("algorithm2");
+  if (canonical.planner().empty()) canonical.set_planner(kDefaultPlanner);
   std::string bytes;
   google::protobuf::io::StringOutputStream stream(&bytes);
   google::protobuf::io::CodedOutputStream coded(&stream);
@@ -74,7 +74,7 @@ grpc::Status PlanningServiceImpl::plan_or_cached(grpc::ServerContext* context, c
     try {
       PlanningInput input{array_from_proto(request.array(), limits), load_goal(request.goal(), maps, limits),
                           max_height_from_proto(request.goal().options()),
-                          request.planner().empty() ? "algorithm2" : request.planner(),
+                          request.planner().empty() ? std::string(kDefaultPlanner) : request.planner(),
                           heights_from_proto(request.goal())};
       const Mesh mesh(input.array.geometry);
       int settled = 0;

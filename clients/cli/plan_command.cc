@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <string_view>
 #include <nlohmann/json.hpp>
 
 #include "args.h"
@@ -14,6 +15,7 @@
 #include "metrics/correlation.h"
 #include "metrics/error_breakdown.h"
 #include "metrics/laplace_predictor.h"
+#include "plan/default_planner.h"
 #include "plan/planner.h"
 #include "plan/refused_json.h"
 #include "progress.h"
@@ -56,9 +58,10 @@ constexpr const char* kPlanUsage =
     "                        georef) to west,south,east,north in degrees (WGS 84)\n"
     "  --encoding E          PNG pixels: grey (default), terrain-rgb (Mapbox) or terrarium\n"
     "  --no-sidecar          ignore NAME.json beside the goal (it turns DEMs north-up)\n";
+static_assert(std::string_view(kDefaultPlanner) == "algorithm2", "kPlanUsage names the default planner");
 
 struct PlanArgs {
-  std::string goal, out, planner = "algorithm2", region, region_lonlat;
+  std::string goal, out, planner = kDefaultPlanner, region, region_lonlat;
   int rows = 0, cols = 0, segments = 4;
   double max_height_mm = 0.0;  // 0: the array's default relief (default_relief_mm)
   bool hue = false, json = false;

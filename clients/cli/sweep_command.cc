@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "args.h"
@@ -45,6 +46,7 @@ constexpr const char* kSweepUsage =
     "  --view-resolution N pixels of a mesh's top view along its longer side (default 256)\n"
     "  --encoding E        PNG pixels: grey (default), terrain-rgb or terrarium\n"
     "  --no-sidecar        ignore NAME.json beside a goal (orientation, georef)\n";
+static_assert(std::string_view(kDefaultPlanner) == "algorithm2", "kSweepUsage names the default planner");
 
 struct SweepArgs {
   std::vector<std::string> goals;

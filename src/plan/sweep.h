@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "metrics/laplace_predictor.h"
+#include "plan/default_planner.h"
 #include "shapes/height_map.h"
 
 namespace hj {
@@ -36,7 +37,7 @@ struct SweepGoal {
 
 struct SweepOptions {
   std::vector<ArraySize> sizes = paper_array_sizes();
-  std::string planner = "algorithm2";
+  std::string planner = kDefaultPlanner;
   int segments = 4;
   double max_height_mm = 0.0;  // goal relief, mm; 0: each array's default_relief_mm
   int jobs = 0;            // threads; 0 = std::thread::hardware_concurrency()
