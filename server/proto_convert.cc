@@ -65,12 +65,14 @@ ImportOptions import_options_from_proto(const v1::GoalOptions& options, const Se
   ImportOptions out;
   out.hue = options.encoding() == v1::HEIGHT_ENCODING_HUE;
   out.max_pixels = limits.max_goal_pixels;
-  std::string axis = options.up_axis().empty() ? "z" : options.up_axis();
-  out.mesh_up_negative = axis[0] == '-';
-  if (out.mesh_up_negative) axis.erase(0, 1);
-  if (axis != "x" && axis != "y" && axis != "z")
-    throw std::invalid_argument("goal.options.up_axis must be x, y, z, -x, -y or -z, got \"" + options.up_axis() + "\"");
-  out.mesh_up_axis = axis[0];
+  // Empty: the importer's default, the mesh's sidecar "up_axis" if it has one, else z.
+  if (std::string axis = options.up_axis(); !axis.empty()) {
+    out.mesh_up_negative = axis[0] == '-';
+    if (out.mesh_up_negative) axis.erase(0, 1);
+    if (axis != "x" && axis != "y" && axis != "z")
+      throw std::invalid_argument("goal.options.up_axis must be x, y, z, -x, -y or -z, got \"" + options.up_axis() + "\"");
+    out.mesh_up_axis = axis[0];
+  }
   if (options.view_resolution() < 0)
     throw std::invalid_argument("goal.options.view_resolution must be positive (0 = 256)");
   check_count("goal.options.view_resolution", options.view_resolution(), limits.max_view_resolution);

@@ -126,6 +126,40 @@ MeshFacts read_facts(const std::filesystem::path& json) {
   return f;
 }
 
+TEST(MeshImport, TheSidecarsUpAxisIsTheDefault) {
+  // plan, sweep and the server import a shared mesh the same way: its
+  // NAME.json says which way is up unless the caller says otherwise.
+  const std::filesystem::path bunny = kMeshDir / "stanford_bunny.stl";
+  const MeshFacts facts = read_facts(kMeshDir / "stanford_bunny.json");
+  ImportOptions stated;
+  stated.mesh_up_axis = char('x' + facts.up);
+  stated.mesh_up_negative = facts.negative;
+  ASSERT_NE(stated.mesh_up_axis, 'z');
+  // Top views hold NaN where nothing is seen: equal means the same NaNs and values.
+  const auto same_view = [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+    return a.rows() == b.rows() && a.cols() == b.cols() && (a.array().isNaN() == b.array().isNaN()).all() &&
+           (a.array().isNaN()).select(0.0, a.array() - b.array()).abs().maxCoeff() == 0.0;
+  };
+  EXPECT_TRUE(same_view(import_goal(bunny).z, import_goal(bunny, stated).z));
+  ImportOptions no_sidecar, z_up;
+  no_sidecar.sidecar = false;
+  z_up.mesh_up_axis = 'z';
+  EXPECT_TRUE(same_view(import_goal(bunny, no_sidecar).z, import_goal(bunny, z_up).z));
+  EXPECT_FALSE(same_view(import_goal(bunny, no_sidecar).z, import_goal(bunny).z));
+}
+
+TEST(MeshImport, ASidecarWithABadUpAxisIsNamed) {
+  const ScratchDir dir("bad-up");
+  write_ascii_stl(dir.path / "box.stl", box(V(0, 0, 0), V(1, 1, 1)));
+  std::ofstream(dir.path / "box.json") << R"({"up_axis": "+W"})";
+  expect_error<ImportError>([&] { (void)import_goal(dir.path / "box.stl"); }, {"box.json", "+W", "up_axis"});
+  ImportOptions stated;
+  stated.mesh_up_axis = 'z';  // an up axis the caller states is not read from the sidecar
+  EXPECT_NO_THROW((void)import_goal(dir.path / "box.stl", stated));
+  std::ofstream(dir.path / "box.json", std::ios::trunc) << "{not json";
+  expect_error<ImportError>([&] { (void)import_goal(dir.path / "box.stl"); }, {"box.json", "not valid JSON"});
+}
+
 TEST(MeshImport, RealMeshesFromSharedData) {
   const std::vector<std::pair<std::string, std::string>> meshes = {
       {"stanford_bunny.stl", "stanford_bunny"}, {"stanford_bunny.obj", "stanford_bunny"},

@@ -104,22 +104,10 @@ bool is_mesh(const std::filesystem::path& file) {
   return false;
 }
 
-// A mesh's up axis: --up-axis, else its sidecar's "up_axis" ("+Y (...)"), else z.
+// A mesh's up axis: --up-axis, else the importer's default (its sidecar's "up_axis", else z).
 ImportOptions import_options_for(const std::filesystem::path& goal, const SweepArgs& args) {
   ImportOptions o = args.import;
-  if (!is_mesh(goal)) return o;
-  std::string axis = args.up_axis;
-  const auto sidecar = goal.parent_path() / (goal.stem().string() + ".json");
-  if (axis.empty() && args.import.sidecar && std::filesystem::is_regular_file(sidecar)) {
-    try {
-      std::ifstream in(sidecar);
-      const auto doc = nlohmann::json::parse(in);
-      if (doc.contains("up_axis") && doc["up_axis"].is_string()) axis = doc["up_axis"].get<std::string>().substr(0, 2);
-    } catch (const nlohmann::json::exception& e) {
-      throw std::runtime_error("sidecar \"" + sidecar.string() + "\" of goal \"" + goal.string() + "\" is not valid JSON: " + e.what());
-    }
-  }
-  if (!axis.empty()) std::tie(o.mesh_up_axis, o.mesh_up_negative) = parse_axis(axis);
+  if (is_mesh(goal) && !args.up_axis.empty()) std::tie(o.mesh_up_axis, o.mesh_up_negative) = parse_axis(args.up_axis);
   return o;
 }
 

@@ -64,8 +64,8 @@ void ImportOptions::validate() const {
   if (max_pixels <= 0)
     throw std::invalid_argument("ImportOptions.max_pixels must be a positive pixel count, got " +
                                 std::to_string(max_pixels));
-  if (mesh_up_axis != 'x' && mesh_up_axis != 'y' && mesh_up_axis != 'z')
-    throw std::invalid_argument("ImportOptions.mesh_up_axis must be 'x', 'y' or 'z' (mesh_up_negative for -), got '" +
+  if (mesh_up_axis != 0 && mesh_up_axis != 'x' && mesh_up_axis != 'y' && mesh_up_axis != 'z')
+    throw std::invalid_argument("ImportOptions.mesh_up_axis must be 'x', 'y', 'z' (mesh_up_negative for -) or 0 (the sidecar's), got '" +
                                 std::string(1, mesh_up_axis) + "'");
   if (hue && encoding != PixelEncoding::kGrey)
     throw std::invalid_argument("ImportOptions.hue and ImportOptions.encoding (terrain-rgb / terrarium) exclude each other");

@@ -37,7 +37,9 @@ struct ImportOptions {
   long max_pixels = 50'000'000;
   // Meshes (mesh_importer.cc): the model axis that points up, 'x', 'y' or 'z',
   // negated when mesh_up_negative; the mesh is rotated so it becomes +z.
-  char mesh_up_axis = 'z';
+  // 0: the sidecar's "up_axis" when sidecar is on and NAME.json has one
+  // (sidecar_up_axis), else +z.
+  char mesh_up_axis = 0;
   bool mesh_up_negative = false;
   // Meshes: pixels along the longer horizontal side of the top view; its
   // square must not exceed max_pixels.

@@ -13,6 +13,10 @@
 #include <set>
 #include <string>
 #include <system_error>
+#include <tuple>
+#include <utility>
+
+#include "shapes/sidecar.h"
 
 namespace hj {
 namespace {
@@ -185,6 +189,9 @@ std::vector<Triangle3d> load_mesh_triangles(const std::filesystem::path& file, c
     throw ImportError(file, std::to_string(n) + " triangles is over the limit of " + std::to_string(kMaxMeshTriangles));
 
   // Every triangle, rotated so the chosen up axis is +z.
+  auto [up_axis, up_negative] = std::make_pair(options.mesh_up_axis, options.mesh_up_negative);
+  if (up_axis == 0) std::tie(up_axis, up_negative) = options.sidecar ? sidecar_up_axis(file).value_or(std::make_pair('z', false))
+                                                                     : std::make_pair('z', false);
   std::vector<Triangle3d> triangles;
   triangles.reserve(size_t(n));
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -194,7 +201,7 @@ std::vector<Triangle3d> load_mesh_triangles(const std::filesystem::path& file, c
       if (face.mNumIndices != 3) continue;
       Triangle3d& t = triangles.emplace_back();
       for (int k = 0; k < 3; ++k) {
-        t[k] = to_z_up(mesh.mVertices[face.mIndices[k]], options.mesh_up_axis, options.mesh_up_negative);
+        t[k] = to_z_up(mesh.mVertices[face.mIndices[k]], up_axis, up_negative);
         if (!t[k].allFinite())
           throw ImportError(file, "a vertex of mesh " + std::to_string(m) + " has a non-finite coordinate");
       }

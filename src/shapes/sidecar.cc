@@ -1,6 +1,7 @@
 #include "shapes/sidecar.h"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -121,6 +122,33 @@ void apply_sidecar(const std::filesystem::path& goal_file, HeightMap& map) {
   } catch (const std::invalid_argument& e) {
     fail(std::string("has an orientation that is not understood: ") + e.what());
   }
+}
+
+std::optional<std::pair<char, bool>> sidecar_up_axis(const std::filesystem::path& mesh_file) {
+  const auto sidecar = mesh_file.parent_path() / (mesh_file.stem().string() + ".json");
+  if (mesh_file.extension() == ".json" || !std::filesystem::is_regular_file(sidecar)) return std::nullopt;
+  const auto fail = [&](const std::string& what) {
+    throw ImportError(mesh_file, "its sidecar \"" + sidecar.string() + "\" " + what +
+                                     " (--up-axis, or --no-sidecar to ignore the sidecar)");
+  };
+  nlohmann::json doc;
+  try {
+    std::ifstream in(sidecar);
+    doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    fail(std::string("is not valid JSON: ") + e.what());
+  }
+  if (!doc.is_object() || !doc.contains("up_axis")) return std::nullopt;
+  if (!doc["up_axis"].is_string()) fail("has an \"up_axis\" that is not a string");
+  const std::string text = doc["up_axis"];
+  std::size_t at = 0;
+  bool negative = false;
+  if (at < text.size() && (text[at] == '+' || text[at] == '-')) negative = text[at++] == '-';
+  const char axis = at < text.size() ? char(std::tolower(static_cast<unsigned char>(text[at]))) : 0;
+  const bool ends = at + 1 == text.size() || !std::isalnum(static_cast<unsigned char>(text[at + 1]));
+  if ((axis != 'x' && axis != 'y' && axis != 'z') || !ends)
+    fail("has up_axis \"" + text + "\", not one of +x, -x, +y, -y, +z, -z");
+  return std::make_pair(axis, negative);
 }
 
 }  // namespace hj

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <utility>
 #include <string>
 
 #include "shapes/height_map.h"
@@ -29,5 +31,12 @@ void apply_sidecar(const std::filesystem::path& goal_file, HeightMap& map);
 // georeference, if any, is transformed along, so every pixel keeps its place.
 // @throws std::invalid_argument naming the expression and the part not understood.
 HeightMap reorient(const HeightMap& map, const std::string& numpy_expression);
+
+// A mesh's up axis from NAME.json beside it (shared/data/mesh/*.json):
+// "up_axis": "+Y", "-z (...)", ...: the axis letter and whether it is
+// negative; empty when there is no sidecar or it has no "up_axis".
+// @throws ImportError naming the sidecar when it is not valid JSON or the
+//         axis is not one of +-x, +-y, +-z.
+std::optional<std::pair<char, bool>> sidecar_up_axis(const std::filesystem::path& mesh_file);
 
 }  // namespace hj
