@@ -17,8 +17,8 @@ namespace hj {
 namespace {
 
 // Steps (fast control, flow and polish together, SettleReport::iterations)
-// the 2 to 2.5 kPa settle may take; it takes 77.
-constexpr int kMaxSnapSteps = 85;
+// the 2 to 2.5 kPa settle may take; it takes 153.
+constexpr int kMaxSnapSteps = 160;
 
 struct ExplicitPoint {
   int row, col;

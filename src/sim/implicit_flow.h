@@ -3,8 +3,7 @@
 //   mu (x_{n+1} - x_n) = F(x_{n+1}),   mu = c / dt,
 // each step solved by Newton on (K + mu I) dx = F - mu (x - x_n) with the
 // exact sparse stiffness K = -dF/dx, dt growing while Newton converges in
-// few iterations (while the move stays near the cap) and shrinking when it
-// does not. Unlike the static solver's
+// few iterations and shrinking when it does not. Unlike the static solver's
 // single regularised Newton step per iteration, judged on whether its
 // linear model predicts the new residual, a step here is judged only on
 // whether it solves its own implicit equation: the flow may carry the
@@ -28,7 +27,7 @@ struct ImplicitFlowOptions {
   int max_steps = 400;                 // backward Euler steps (4 x 6 snap: 65)
   int newton_iterations = 6;           // per step, before dt is cut
   double initial_shift = 1.0;          // mu at the start, in units of spring_k
-  double max_step_fraction = 2.0;      // largest move of a point per step, in h (as the fast control's)
+  double max_step_fraction = 0.5;      // largest move of a point per step, in h
   // Polled every step; true throws SettleInterrupted (state left mid-way).
   std::function<bool()> interrupted;
   // Asked of the positions after every accepted step; true ends the flow
