@@ -17,6 +17,12 @@ namespace {
 // The fast control gives up once a trial residual exceeds this multiple of
 // the one it started from: heading away, it would only spend its budget.
 constexpr double kAbandonGrowth = 100.0;
+// The fast control gives up once its residual has not halved in this many
+// steps: where it converges it halves every step or two, and where there is
+// no equilibrium near the start (a snap-through past a fold) it wanders
+// with the residual going up and down, and the flow that follows does the
+// work (9 x 12, a pinned jammed plate, 2 to 2.5 kPa: 40 steps spent).
+constexpr int kFastStallIterations = 10;
 // Refused careful steps after which the control remembers the shifts it
 // refused (Continuation::judge_model_trust).
 constexpr int kRefusalsBeforeMemory = 50;
@@ -228,14 +234,16 @@ void Continuation::keep_push_in_mirror_class(Eigen::Matrix3Xd& push) {
 }
 
 // Tracks when the residual last halved; true when a careful control has
-// gone stall_iterations without (nothing to converge to).
+// gone stall_iterations without (nothing to converge to), or the fast one
+// kFastStallIterations (outside a push, whose steps climb out of a saddle).
 bool Continuation::stalled(int it) {
   if (const double norm = active_->force_norm(residual_); norm < 0.5 * halved_norm_) {
     halved_norm_ = norm;
     halved_at_ = it;
     return false;
   }
-  return control_ != StepControl::kDisplacement && pushed_at_ < 0 && it - halved_at_ > options_.stall_iterations;
+  const int limit = control_ == StepControl::kDisplacement ? kFastStallIterations : options_.stall_iterations;
+  return pushed_at_ < 0 && it - halved_at_ > limit;
 }
 
 // One step: a trial, judged by the control, taken or refused.

@@ -1,8 +1,12 @@
-// Settling speed: from rest to 2 kPa, and one action after that (jam a cell,
-// then 1 kPa), for the static solver and the paper's explicit Euler.
+// Settling speed: from rest to 2 kPa, one action after that (jam a cell,
+// then 1 kPa), and a jam-and-pin session, for the static solver and the
+// paper's explicit Euler; BM_SettleJamPinSessionSpeedup runs both on the
+// session and reports their ratio.
 // Run: ./build/hj_bench --benchmark_filter=Settle
 #include <benchmark/benchmark.h>
 
+#include <chrono>
+#include <ctime>
 #include <exception>
 #include <functional>
 
@@ -70,19 +74,29 @@ void BM_SettleCentreJamThenStep(benchmark::State& state) {
 // A planner's session end to end, as one timed run from a fresh simulator:
 // rest, 2 kPa, jam the centre cell, pin a node of it, 2.5 kPa. (With a
 // corner cell jammed and pinned instead, 9 x 12 has no equilibrium at 2.5 kPa.)
-void BM_SettleJamPinSession(benchmark::State& state) {
-  const ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038,
-                        static_cast<int>(state.range(2))};
+ArrayGeometry session_geometry(const benchmark::State& state) {
+  return {static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038, static_cast<int>(state.range(2))};
+}
+
+// The session from a fresh simulator; returns the solver iterations of all its settles.
+long run_jam_pin_session(const ArrayGeometry& g, SolverKind solver) {
   SimulatorOptions options;
-  options.solver = state.range(3) == 0 ? SolverKind::kStatic : SolverKind::kExplicit;
+  options.solver = solver;
   const Action session[] = {Action::set_pressure(2000.0), Action::jam(g.rows / 2, g.cols / 2),
                             Action::pin(g.rows / 2, g.cols / 2), Action::set_pressure(2500.0)};
+  hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
+  long iterations = sim.last_settle().iterations;
+  for (const Action& a : session) iterations += sim.apply(a).iterations;
+  return iterations;
+}
+
+void BM_SettleJamPinSession(benchmark::State& state) {
+  const ArrayGeometry g = session_geometry(state);
+  const SolverKind solver = state.range(3) == 0 ? SolverKind::kStatic : SolverKind::kExplicit;
   long iterations = 0;
   for (auto _ : state) {
     try {
-      hj::Simulator sim(g, hj::SurfaceParameters::paper_defaults(g), options);
-      iterations += sim.last_settle().iterations;
-      for (const Action& a : session) iterations += sim.apply(a).iterations;
+      iterations += run_jam_pin_session(g, solver);
     } catch (const std::exception& e) {
       state.SkipWithError(e.what());
       break;
@@ -92,15 +106,61 @@ void BM_SettleJamPinSession(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
 }
 
+// Seconds of CPU this process has used: on a shared machine the fairer
+// clock for a ratio of two long runs.
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// The same session by both solvers in one run, each timed end to end:
+// static_s, explicit_s (wall) and speedup = explicit_s / static_s, and the
+// same on CPU time (static_cpu_s, explicit_cpu_s, speedup_cpu). The
+// benchmark's own time is the sum.
+void BM_SettleJamPinSessionSpeedup(benchmark::State& state) {
+  using Clock = std::chrono::steady_clock;
+  const ArrayGeometry g = session_geometry(state);
+  double wall[2] = {0.0, 0.0}, cpu[2] = {0.0, 0.0};
+  long iterations[2] = {0, 0};
+  for (auto _ : state) {
+    for (int i = 0; i < 2; ++i) {
+      const auto start = Clock::now();
+      const double cpu_start = process_cpu_seconds();
+      try {
+        iterations[i] += run_jam_pin_session(g, i == 0 ? SolverKind::kStatic : SolverKind::kExplicit);
+      } catch (const std::exception& e) {
+        state.SkipWithError(e.what());
+        return;
+      }
+      wall[i] += std::chrono::duration<double>(Clock::now() - start).count();
+      cpu[i] += process_cpu_seconds() - cpu_start;
+    }
+  }
+  const auto average = [](double total) { return benchmark::Counter(total, benchmark::Counter::kAvgIterations); };
+  state.counters["static_s"] = average(wall[0]);
+  state.counters["explicit_s"] = average(wall[1]);
+  state.counters["static_cpu_s"] = average(cpu[0]);
+  state.counters["explicit_cpu_s"] = average(cpu[1]);
+  state.counters["static_iterations"] = average(static_cast<double>(iterations[0]));
+  state.counters["explicit_iterations"] = average(static_cast<double>(iterations[1]));
+  state.counters["speedup"] = wall[1] / wall[0];
+  state.counters["speedup_cpu"] = cpu[1] / cpu[0];
+}
+
 BENCHMARK(BM_SettleRestTo2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_SettleCentreJamThenStep)->Args({3, 4, 4, 0})->Args({3, 4, 4, 1})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
 // The slow ones, run by name: 9 x 12 explicit, p = 10 (both solvers;
 // explicit Euler there takes over an hour), and the 9 x 12
 // jammed step (2 -> 1 kPa; a corner cell jammed keeps no mirror, so it
-// settles on every DOF: 113 steps, 1.3-1.6 s on 2026-12-01).
+// settles on every DOF).
 BENCHMARK(BM_SettleJamPinSession)->Args({3, 4, 4, 0})->Args({9, 12, 4, 0})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleJamPinSession)->Name("Slow/BM_SettleJamPinSession")->Args({3, 4, 4, 1})->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
+// Both solvers on the session in one run (args: rows, cols, segments); the
+// 9 x 12 one, slow, spends nearly all its time in explicit Euler.
+BENCHMARK(BM_SettleJamPinSessionSpeedup)->Args({3, 4, 4})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_SettleJamPinSessionSpeedup)->Name("Slow/BM_SettleJamPinSessionSpeedup")->Args({9, 12, 4})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleRestTo2kPa)->Name("Slow/BM_SettleRestTo2kPa")->Args({9, 12, 4, 1})->Args({9, 12, 10, 0})->Args({9, 12, 10, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleOneActionAfter2kPa)->Name("Slow/BM_SettleOneActionAfter2kPa")->Args({9, 12, 4, 0})->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_SettleCentreJamThenStep)->Name("Slow/BM_SettleCentreJamThenStep")->Args({9, 12, 4, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
