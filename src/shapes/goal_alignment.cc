@@ -92,8 +92,8 @@ Region transformed_window(const Region& window, const GoalTransform& t, const Ar
   const double cy = 0.5 * (window.y0 + window.y1) - t.shift_y_cells * height / geometry.rows;
   Region out;
   out.fractions = false;
-  out.x0 = std::round(cx - 0.5 * width);
-  out.y0 = std::round(cy - 0.5 * height);
+  out.x0 = std::round(cx - 0.5 * width) + 0.0;  // + 0.0: no -0 in reports
+  out.y0 = std::round(cy - 0.5 * height) + 0.0;
   out.x1 = out.x0 + std::max(1.0, std::round(width));
   out.y1 = out.y0 + std::max(1.0, std::round(height));
   return out;
