@@ -12,6 +12,7 @@
 #include "cli_runner.h"
 #include "expect_error.h"
 #include "plan/aligned_plan.h"
+#include "plan/sweep.h"
 #include "scratch_dir.h"
 #include "shapes/goal_alignment.h"
 
@@ -165,6 +166,48 @@ TEST(GoalAlignment, TheAlignedPlanIsNeverWorseThanTheUnaligned) {
   // The goal kept is the chosen window, at the mesh points and as the image scored.
   EXPECT_EQ(plan.goal.z.cols(), long(plan.chosen.window.x1 - plan.chosen.window.x0));
   EXPECT_EQ(plan.goal.z.rows(), long(plan.chosen.window.y1 - plan.chosen.window.y0));
+}
+
+TEST(GoalAlignment, SweepReportsTheTransformAndTheUnalignedCorrelation) {
+  SweepOptions options;
+  options.sizes = {{3, 4}};
+  options.jobs = 1;
+  options.align = AlignedPlanOptions{};
+  const auto rows = run_sweep({{"valley", plateau_with_valley(u_of(1.5), v_of(1.5))}}, options);
+  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_EQ(rows[0].status, "ok") << rows[0].detail;
+  ASSERT_TRUE(rows[0].align && rows[0].align->unaligned_correlation && rows[0].correlation);
+  EXPECT_GE(*rows[0].correlation, *rows[0].align->unaligned_correlation);
+  EXPECT_GE(rows[0].align->planned, 2);
+}
+
+TEST(GoalAlignment, PlanWritesTheTransformAndGainOfARegion) {
+  using namespace testing_support;
+  ScratchDir dir;
+  const auto csv = dir.path / "valley.csv";
+  {
+    const HeightMap map = plateau_with_valley(u_of(1.5), v_of(1.5));
+    std::ofstream out(csv);
+    for (long r = 0; r < map.z.rows(); ++r)
+      for (long c = 0; c < map.z.cols(); ++c) out << map.z(r, c) << (c + 1 < map.z.cols() ? "," : "\n");
+  }
+  const auto out = dir.path / "out";
+  ASSERT_EQ(run_cli("plan " + quoted(csv) + " --rows 3 --cols 4 --region 80,60,240,180 --align --json --out " +
+                        quoted(out),
+                    dir.path),
+            0)
+      << read_text(dir.path / "stderr.txt");
+  const auto plan = nlohmann::json::parse(read_text(out / "plan.json"));
+  ASSERT_TRUE(plan.contains("align"));
+  const auto& align = plan["align"];
+  for (const char* key : {"shift_x_cells", "shift_y_cells", "scale", "window", "correlation", "unaligned_correlation",
+                          "gain", "candidates", "planned"})
+    EXPECT_TRUE(align.contains(key)) << key;
+  EXPECT_GE(align["gain"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(plan["correlation"].get<double>(), align["correlation"].get<double>());
+  EXPECT_LE(std::abs(align["shift_x_cells"].get<double>()), 0.5);
+  const auto summary = nlohmann::json::parse(read_text(dir.path / "stdout.txt"));
+  EXPECT_DOUBLE_EQ(summary["align"]["gain"].get<double>(), align["gain"].get<double>());
 }
 
 TEST(GoalAlignment, PlanRefusesAlignWithAbsoluteHeights) {
