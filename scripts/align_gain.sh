@@ -3,7 +3,9 @@
 # and 6 x 8, with algorithm2 and algorithm2-levelled: one `sweep --align`
 # per planner, then mean, best and worst gain and the time cost per planner
 # and size. Usage: scripts/align_gain.sh [OUT_DIR] (default /tmp/align-gain);
-# HJ_BIN (default build/hapticjam), JOBS (sweep threads, default 2).
+# HJ_BIN (default build/hapticjam), JOBS (sweep threads, default 2),
+# PICK=random for the control: as many windows picked at random instead of
+# by valley cost (sweep --align-pick).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${HJ_BIN:-$root/build/hapticjam}
@@ -11,7 +13,7 @@ shared=$root/../shared/data
 out=${1:-/tmp/align-gain}
 goals=("$shared"/dem/*.csv "$shared"/dem/*.tif "$shared"/mesh/*.stl "$shared"/mesh/*.obj)
 for planner in algorithm2 algorithm2-levelled; do
-  nice -n 10 "$bin" sweep "${goals[@]}" --sizes 3x4,6x8 --planner "$planner" --align --jobs "${JOBS:-2}" \
+  nice -n 10 "$bin" sweep "${goals[@]}" --sizes 3x4,6x8 --planner "$planner" --align-pick "${PICK:-cost}" --jobs "${JOBS:-2}" \
     --out "$out/$planner" >"$out.$planner.log"
 done
 python3 - "$out" <<'PY'

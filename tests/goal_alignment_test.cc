@@ -163,6 +163,13 @@ TEST(GoalAlignment, TheAlignedPlanIsNeverWorseThanTheUnaligned) {
   EXPECT_DOUBLE_EQ(plan.unaligned_score, plan.planned.front().score);
   for (const auto& p : plan.planned) EXPECT_LE(p.score, plan.score);
   EXPECT_GE(plan.gain(), 0.0);
+  // The random control plans as many windows whatever their cost, and is held to the same rule.
+  AlignedPlanOptions control;
+  control.pick = AlignedPlanOptions::Pick::kRandom;
+  control.plans = 1;
+  const AlignedPlan random = plan_aligned("algorithm2", source, kWindow, {kPaper, params, {}, {}, {}}, kReliefMm, control);
+  ASSERT_EQ(random.planned.size(), 2u);
+  EXPECT_GE(random.gain(), 0.0);
   // The goal kept is the chosen window, at the mesh points and as the image scored.
   EXPECT_EQ(plan.goal.z.cols(), long(plan.chosen.window.x1 - plan.chosen.window.x0));
   EXPECT_EQ(plan.goal.z.rows(), long(plan.chosen.window.y1 - plan.chosen.window.y0));

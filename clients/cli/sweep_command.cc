@@ -24,7 +24,8 @@ namespace {
 constexpr const char* kSweepUsage =
     "usage: hapticjam sweep GOAL... --out DIR [--sizes paper|RxC,RxC,...] [--planner NAME]\n"
     "                       [--jobs N] [--budget-s S] [--segments P] [--max-height-mm H]\n"
-    "                       [--up-axis [-]x|y|z] [--view-resolution N] [--encoding E] [--no-sidecar] [--align]\n"
+    "                       [--up-axis [-]x|y|z] [--view-resolution N] [--encoding E] [--no-sidecar]\n"
+    "                       [--align [--align-pick cost|random]]\n"
     "Plans every GOAL at every array size, the plans in parallel (one thread each),\n"
     "and writes DIR/sweep.csv (goal, rows, cols, cells, correlation, the Laplace\n"
     "mean of the goal as resampled to the mesh for each alpha_L, steps, seconds,\n"
@@ -48,7 +49,9 @@ constexpr const char* kSweepUsage =
     "  --align             plan each goal aligned (as plan --align): correlation is the\n"
     "                      aligned goal's; sweep.csv gains align_shift_x_cells,\n"
     "                      align_shift_y_cells, align_scale, unaligned_correlation,\n"
-    "                      align_gain, unaligned_seconds and align_planned\n";
+    "                      align_gain, unaligned_seconds and align_planned\n"
+    "  --align-pick P      cost (default: the windows of lowest valley cost) or random\n"
+    "                      (a control: as many windows at random, seeded); implies --align\n";
 
 struct SweepArgs {
   std::vector<std::string> goals;
@@ -90,7 +93,15 @@ SweepArgs parse_sweep_args(const std::vector<std::string>& args) {
     } else if (a == "--view-resolution") out.import.mesh_resolution = parse_int(a, value(), 1, 8192);
     else if (a == "--encoding") out.import.encoding = parse_pixel_encoding(value());
     else if (a == "--no-sidecar") out.import.sidecar = false;
-    else if (a == "--align") out.options.align = AlignedPlanOptions{};
+    else if (a == "--align") {
+      if (!out.options.align) out.options.align = AlignedPlanOptions{};
+    } else if (a == "--align-pick") {
+      const std::string pick = value();
+      if (pick != "cost" && pick != "random")
+        throw std::invalid_argument("--align-pick needs cost or random, got \"" + pick + "\"");
+      if (!out.options.align) out.options.align = AlignedPlanOptions{};
+      out.options.align->pick = pick == "random" ? AlignedPlanOptions::Pick::kRandom : AlignedPlanOptions::Pick::kValleyCost;
+    }
     else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
     else out.goals.push_back(a);
   }

@@ -1,11 +1,13 @@
 #include "plan/aligned_plan.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <mutex>
 #include <optional>
+#include <random>
 #include <stdexcept>
 #include <thread>
 
@@ -15,11 +17,22 @@ namespace hj {
 namespace {
 
 // The identity, then the candidates the criterion puts closer to the nodes
-// than the identity, lowest cost first, at most `plans` of them.
-std::vector<const AlignmentCandidate*> shortlist(const std::vector<AlignmentCandidate>& candidates, int plans) {
+// than the identity, lowest cost first, at most `plans` of them (or, for the
+// random control, `plans` of any cost).
+std::vector<const AlignmentCandidate*> shortlist(const std::vector<AlignmentCandidate>& candidates,
+                                                 const AlignedPlanOptions& options) {
   std::vector<const AlignmentCandidate*> out{&candidates.front()};
+  if (options.pick == AlignedPlanOptions::Pick::kRandom) {
+    std::vector<const AlignmentCandidate*> others;
+    for (std::size_t k = 1; k < candidates.size(); ++k) others.push_back(&candidates[k]);
+    std::mt19937 random(options.seed);
+    std::shuffle(others.begin(), others.end(), random);
+    others.resize(std::min(others.size(), std::size_t(options.plans)));
+    out.insert(out.end(), others.begin(), others.end());
+    return out;
+  }
   const double identity_cost = candidates.front().valley_cost;
-  for (std::size_t k = 1; k < candidates.size() && int(out.size()) <= plans; ++k)
+  for (std::size_t k = 1; k < candidates.size() && int(out.size()) <= options.plans; ++k)
     if (candidates[k].valley_cost < identity_cost - 1e-9 * std::max(1.0, identity_cost)) out.push_back(&candidates[k]);
   return out;
 }
@@ -55,7 +68,7 @@ AlignedPlan plan_aligned(const std::string& planner, const HeightMap& source, co
   const Mesh mesh(request.geometry);
   const std::vector<AlignmentCandidate> candidates =
       alignment_candidates(source, window, mesh, relief_mm, options.align);
-  const std::vector<const AlignmentCandidate*> chosen_few = shortlist(candidates, options.plans);
+  const std::vector<const AlignmentCandidate*> chosen_few = shortlist(candidates, options);
 
   // Each shortlisted goal planned on its own, scored against its own window.
   struct Outcome {

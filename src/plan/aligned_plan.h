@@ -20,6 +20,12 @@ struct AlignedPlanOptions {
   // only those below the identity's (valleys already on nodes: none), >= 0.
   int plans = 3;
   int threads = 0;  // plans run in parallel; 0: one per core
+  // How the candidates planned besides the identity are picked: by valley
+  // cost, or (a control, to measure what the criterion adds over trying
+  // `plans` other windows) uniformly at random among all, seeded by `seed`.
+  enum class Pick { kValleyCost, kRandom };
+  Pick pick = Pick::kValleyCost;
+  unsigned seed = 1;
   // @throws std::invalid_argument naming the field (AlignedPlanOptions.plans, AlignOptions.*).
   void validate() const;
 };
