@@ -4,15 +4,16 @@
 # per planner, then mean, best and worst gain and the time cost per planner
 # and size. Usage: scripts/align_gain.sh [OUT_DIR] (default /tmp/align-gain);
 # HJ_BIN (default build/hapticjam), JOBS (sweep threads, default 2),
-# PICK=random for the control: as many windows picked at random instead of
-# by valley cost (sweep --align-pick).
+# PLANNERS (default "algorithm2 algorithm2-levelled"), PICK=random for the
+# control: as many windows picked at random instead of by valley cost
+# (sweep --align-pick).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${HJ_BIN:-$root/build/hapticjam}
 shared=$root/../shared/data
 out=${1:-/tmp/align-gain}
 goals=("$shared"/dem/*.csv "$shared"/dem/*.tif "$shared"/mesh/*.stl "$shared"/mesh/*.obj)
-for planner in algorithm2 algorithm2-levelled; do
+for planner in ${PLANNERS:-algorithm2 algorithm2-levelled}; do
   nice -n 10 "$bin" sweep "${goals[@]}" --sizes 3x4,6x8 --planner "$planner" --align-pick "${PICK:-cost}" --jobs "${JOBS:-2}" \
     --out "$out/$planner" >"$out.$planner.log"
 done
@@ -21,6 +22,8 @@ import csv, sys, pathlib
 out = pathlib.Path(sys.argv[1])
 print(f"{'planner':20} {'size':5} {'n':>3} {'mean gain':>9} {'best':>7} {'worst':>7} {'moved':>5} {'time x':>6}")
 for planner in ("algorithm2", "algorithm2-levelled"):
+    if not (out / planner / "sweep.csv").exists():
+        continue
     rows = list(csv.DictReader(open(out / planner / "sweep.csv")))
     for size in ("3x4", "6x8"):
         sel = [r for r in rows if f"{r['rows']}x{r['cols']}" == size and r["align_gain"] != ""]

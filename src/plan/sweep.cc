@@ -89,7 +89,9 @@ SweepRow run_one(const SweepGoal& goal, ArraySize size, const SweepOptions& opti
     row.relief_mm = relief_or_default_mm(options.max_height_mm, geometry);
     PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry), {}, {}, goal.map.z};
     PlanCallbacks callbacks;
-    callbacks.cancelled = [&] { return elapsed() > options.budget_s; };
+    // Aligned, a row plans up to 1 + plans goals one after the other, each within the budget.
+    const double budget_s = options.budget_s * (options.align ? 1 + options.align->plans : 1);
+    callbacks.cancelled = [&] { return elapsed() > budget_s; };
     PlanResult result;
     const HeightMap* scored_goal = &goal.map;
     std::optional<AlignedPlan> aligned;
@@ -122,7 +124,7 @@ SweepRow run_one(const SweepGoal& goal, ArraySize size, const SweepOptions& opti
   } catch (const PlanCancelled&) {
     row.status = "over-budget";
     std::ostringstream s;
-    s << "stopped after " << options.budget_s << " s (budget)";
+    s << "stopped after " << elapsed() << " s (budget " << options.budget_s << " s a plan)";
     row.detail = s.str();
   } catch (const std::exception& e) {
     row.status = "failed";

@@ -44,7 +44,8 @@ struct SweepOptions {
   double budget_s = 120.0;  // per plan; checked between actions (a settle in progress is not interrupted)
   std::vector<double> alphas = table2_alphas();
   // Set: every goal planned aligned (plan_aligned, its plans one after the
-  // other in the sweep's thread; the budget is for all of them together).
+  // other in the sweep's thread; a row's budget is then budget_s times the
+  // number of goals it may plan, 1 + plans).
   std::optional<AlignedPlanOptions> align;
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
