@@ -140,6 +140,9 @@ TEST(GoalAlignment, BadOptionsNameTheField) {
   AlignedPlanOptions plans;
   plans.plans = -1;
   expect_error<std::invalid_argument>([&] { plans.validate(); }, {"AlignedPlanOptions.plans"});
+  plans = {};
+  plans.max_time_ratio = 0.5;
+  expect_error<std::invalid_argument>([&] { plans.validate(); }, {"AlignedPlanOptions.max_time_ratio"});
 
   const HeightMap source = plateau_with_valley(u_of(1.5), v_of(1.5));
   const Mesh mesh(kPaper);

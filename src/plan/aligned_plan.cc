@@ -58,6 +58,9 @@ void AlignedPlanOptions::validate() const {
   align.validate();
   if (plans < 0) throw std::invalid_argument("AlignedPlanOptions.plans must be >= 0, got " + std::to_string(plans));
   if (threads < 0) throw std::invalid_argument("AlignedPlanOptions.threads must be >= 0 (0: one per core)");
+  if (!(max_time_ratio >= 1.0) || !std::isfinite(max_time_ratio))
+    throw std::invalid_argument("AlignedPlanOptions.max_time_ratio must be a finite number >= 1, got " +
+                                std::to_string(max_time_ratio));
 }
 
 AlignedPlan plan_aligned(const std::string& planner, const HeightMap& source, const Region& window,
@@ -81,6 +84,8 @@ AlignedPlan plan_aligned(const std::string& planner, const HeightMap& source, co
   std::mutex mutex;  // serialises progress and the cancellation below
   std::exception_ptr cancelled, identity_error;
   int finished = 0;
+  using Clock = std::chrono::steady_clock;
+  std::atomic<double> identity_seconds{-1.0};  // set when the unaligned plan ends
   run_parallel(chosen_few.size(), options.threads, [&](std::size_t k) {
     const AlignmentCandidate& c = *chosen_few[k];
     Outcome& out = outcomes[k];
@@ -89,20 +94,32 @@ AlignedPlan plan_aligned(const std::string& planner, const HeightMap& source, co
     out.request = request;
     out.request.goal_mm = c.goal_mm;
     out.request.goal_image = out.goal.z;
+    const auto start = Clock::now();
+    const auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+    bool too_slow = false;
     PlanCallbacks own;
-    own.cancelled = callbacks.cancelled;
-    const auto start = std::chrono::steady_clock::now();
+    own.cancelled = [&] {
+      if (callbacks.cancelled && callbacks.cancelled()) return true;
+      const double limit = identity_seconds.load();
+      too_slow = k > 0 && limit >= 0.0 && seconds() > options.max_time_ratio * std::max(limit, 1.0);
+      return too_slow;
+    };
     try {
       out.result = make_planner(planner)->plan(out.request, own);
       out.record.score = plan_score(out.request, mesh, out.result->final_state);
     } catch (const PlanCancelled&) {
-      const std::lock_guard<std::mutex> lock(mutex);
-      cancelled = std::current_exception();
+      if (too_slow) {
+        out.record.error = "stopped at " + std::to_string(options.max_time_ratio) + " x the unaligned plan's time";
+      } else {
+        const std::lock_guard<std::mutex> lock(mutex);
+        cancelled = std::current_exception();
+      }
     } catch (const std::exception& e) {
       out.record.error = e.what();
       if (k == 0) identity_error = std::current_exception();
     }
-    out.record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.record.seconds = seconds();
+    if (k == 0) identity_seconds = out.record.seconds;
     const std::lock_guard<std::mutex> lock(mutex);
     ++finished;
     if (callbacks.progress)

@@ -20,6 +20,10 @@ struct AlignedPlanOptions {
   // only those below the identity's (valleys already on nodes: none), >= 0.
   int plans = 3;
   int threads = 0;  // plans run in parallel; 0: one per core
+  // A candidate's plan is stopped (and not chosen) once it has run this many
+  // times as long as the unaligned goal's plan (at least 1 s), so a window
+  // that drives the planner into slow dead ends costs a bounded time; >= 1.
+  double max_time_ratio = 3.0;
   // How the candidates planned besides the identity are picked: by valley
   // cost, or (a control, to measure what the criterion adds over trying
   // `plans` other windows) uniformly at random among all, seeded by `seed`.
@@ -35,7 +39,7 @@ struct PlannedCandidate {
   Region window;
   double valley_cost = 0.0;
   double score = 0.0;  // plan_score; -inf when undefined or the plan failed
-  std::string error;   // why its plan failed, if it did
+  std::string error;   // why its plan failed or was stopped, if it was
   double seconds = 0.0;
 };
 
