@@ -7,6 +7,7 @@
 #include <iostream>
 #include <string_view>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "args.h"
 #include "calib/frame_csv.h"
@@ -15,6 +16,8 @@
 #include "metrics/correlation.h"
 #include "metrics/error_breakdown.h"
 #include "metrics/laplace_predictor.h"
+#include "plan/aligned_plan.h"
+#include "plan/aligned_plan_json.h"
 #include "plan/default_planner.h"
 #include "plan/planner.h"
 #include "plan/refused_json.h"
@@ -33,7 +36,7 @@ constexpr const char* kPlanUsage =
     "usage: hapticjam plan GOAL --rows R --cols C --out DIR [--segments P] [--planner NAME]\n"
     "                      [--max-height-mm H | --heights absolute] [--region x0,y0,x1,y1] [--hue] [--json]\n"
     "                      [--up-axis [-]x|y|z] [--view-resolution N]\n"
-    "                      [--region-lonlat lon0,lat0,lon1,lat1] [--encoding E] [--no-sidecar]\n"
+    "                      [--region-lonlat lon0,lat0,lon1,lat1] [--encoding E] [--no-sidecar] [--align]\n"
     "Plans the actions that make the display show GOAL (a height image: CSV, PNG,\n"
     "TIFF or GeoTIFF, SRTM .hgt; or a mesh: STL, OBJ, PLY, glTF/GLB, 3MF, seen from\n"
     "above) and writes DIR/plan.json (steps in the session format, correlation,\n"
@@ -58,14 +61,18 @@ constexpr const char* kPlanUsage =
     "  --region-lonlat B     zoom a georeferenced goal (GeoTIFF, .hgt, CSV with a sidecar\n"
     "                        georef) to west,south,east,north in degrees (WGS 84)\n"
     "  --encoding E          PNG pixels: grey (default), terrain-rgb (Mapbox) or terrarium\n"
-    "  --no-sidecar          ignore NAME.json beside the goal (it turns DEMs north-up)\n";
+    "  --no-sidecar          ignore NAME.json beside the goal (it turns DEMs north-up)\n"
+    "  --align               shift the goal's window by up to half a cell and scale it to\n"
+    "                        0.8..1 of its side so its valleys fall on nodes; plans the\n"
+    "                        unaligned goal and the best few candidates and keeps the best\n"
+    "                        (plan.json \"align\": transform and gain; docs/planners.md)\n";
 static_assert(std::string_view(kDefaultPlanner) == "algorithm2", "kPlanUsage names the default planner");
 
 struct PlanArgs {
   std::string goal, out, planner = kDefaultPlanner, region, region_lonlat;
   int rows = 0, cols = 0, segments = 4;
   double max_height_mm = 0.0;  // 0: the array's default relief (default_relief_mm)
-  bool hue = false, json = false;
+  bool hue = false, json = false, align = false;
   GoalHeights heights = GoalHeights::kScaled;
   ImportOptions import;
 };
@@ -95,6 +102,7 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
       out.import.mesh_up_axis = axis[0];
     }
     else if (a == "--json") out.json = true;
+    else if (a == "--align") out.align = true;
     else if (a == "--heights") out.heights = parse_goal_heights(value());
     else if (a == "--max-height-mm") {
       out.max_height_mm = parse_number(a, value());
@@ -113,6 +121,9 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
   if (out.heights == GoalHeights::kAbsolute) {
     if (out.max_height_mm > 0.0) throw std::invalid_argument("--heights absolute and --max-height-mm exclude each other");
     check_absolute_goal_format(out.goal);
+    if (out.align)
+      throw std::invalid_argument("--align and --heights absolute exclude each other: absolute heights are the "
+                                  "surface the user asked for, at the mesh points, not a window to move");
   }
   return out;
 }
@@ -128,11 +139,19 @@ nlohmann::json error_breakdown_to_json(const ErrorBreakdown& b) {
 // Mesh point heights (row i along +y) as an image (row 0 at the top).
 Eigen::MatrixXd as_image(const Eigen::MatrixXd& points) { return points.colwise().reverse(); }
 
+// The pixels of the imported goal the region options take (all of it without one).
+Region goal_window(const HeightMap& imported, const PlanArgs& args) {
+  if (!args.region.empty()) return pixel_region(parse_region(args.region), imported.z.rows(), imported.z.cols());
+  if (!args.region_lonlat.empty()) return lonlat_pixel_region(imported, parse_lonlat_box(args.region_lonlat));
+  return Region{0.0, 0.0, double(imported.z.cols()), double(imported.z.rows()), false};
+}
+
 int plan(const PlanArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   ImportOptions import = args.import;
   import.hue = args.hue;
-  HeightMap goal = import_goal(args.goal, import);
+  const HeightMap imported = import_goal(args.goal, import);
+  HeightMap goal = imported;
   if (!args.region.empty()) goal = crop(goal, parse_region(args.region));
   if (!args.region_lonlat.empty()) goal = crop_lonlat(goal, parse_lonlat_box(args.region_lonlat));
   const ArrayGeometry geometry{args.rows, args.cols, 0.038, args.segments};
@@ -149,7 +168,18 @@ int plan(const PlanArgs& args) {
   callbacks.progress = [&](double fraction, const std::string& what) {
     progress.update(static_cast<int>(std::lround(fraction * 100)), 100, what);
   };
-  const PlanResult result = planner->plan(request, callbacks);
+  std::optional<AlignedPlan> aligned;
+  PlanResult result;
+  if (args.align) {
+    // The aligned goal replaces the unaligned one in everything written below.
+    aligned = plan_aligned(args.planner, imported, goal_window(imported, args), request, relief_mm, {}, callbacks);
+    goal = aligned->goal;
+    request.goal_mm = aligned->chosen.goal_mm;
+    request.goal_image = goal.z;
+    result = std::move(aligned->result);
+  } else {
+    result = planner->plan(request, callbacks);
+  }
   progress.finish();
 
   const Eigen::MatrixXd predicted_mm = point_heights(mesh, result.final_state.x) * 1000.0;
@@ -181,6 +211,7 @@ int plan(const PlanArgs& args) {
       {"laplace_mean", laplace}};
   if (!corr.value) doc["correlation_undefined"] = corr.undefined_reason;
   if (!result.note.empty()) doc["planner_note"] = result.note;
+  if (aligned) doc["align"] = aligned_plan_to_json(*aligned);
   doc["refused"] = refused_to_json(result.refused);
   doc["error_breakdown"] = error_breakdown_to_json(error_breakdown(mesh, request.goal_mm, predicted_mm));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -193,6 +224,7 @@ int plan(const PlanArgs& args) {
                               {"correlation", doc["correlation"]},
                               {"laplace_mean", laplace}, {"seconds", seconds},
                               {"refused_seconds", result.refused_seconds}, {"out", args.out}};
+    if (aligned) summary["align"] = aligned_plan_to_json(*aligned, false);
     std::cout << summary.dump() << "\n";
   } else {
     std::printf("%s on %d x %d: %zu steps%s, correlation %s, Laplace mean %.3f, written to %s in %.2f s\n",
@@ -202,6 +234,12 @@ int plan(const PlanArgs& args) {
                                           " actions refused as dead ends, see plan.json)").c_str(),
                 corr.value ? std::to_string(*corr.value).substr(0, 6).c_str() : ("undefined (" + corr.undefined_reason + ")").c_str(),
                 laplace, args.out.c_str(), seconds);
+    if (aligned)
+      std::printf("aligned: window shifted %+.3f, %+.3f cells, scaled %.3f; correlation %.4f against %.4f unaligned "
+                  "(gain %+.4f), %zu goals planned of %d candidates\n",
+                  aligned->chosen.transform.shift_x_cells, aligned->chosen.transform.shift_y_cells,
+                  aligned->chosen.transform.scale, aligned->score, aligned->unaligned_score, aligned->gain(),
+                  aligned->planned.size(), aligned->candidates);
   }
   return 0;
 }

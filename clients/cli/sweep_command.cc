@@ -26,6 +26,7 @@ constexpr const char* kSweepUsage =
     "usage: hapticjam sweep GOAL... --out DIR [--sizes paper|RxC,RxC,...] [--planner NAME]\n"
     "                       [--jobs N] [--budget-s S] [--segments P] [--max-height-mm H]\n"
     "                       [--up-axis [-]x|y|z] [--view-resolution N] [--encoding E] [--no-sidecar]\n"
+    "                       [--align [--align-pick cost|random]]\n"
     "Plans every GOAL at every array size, the plans in parallel (one thread each),\n"
     "and writes DIR/sweep.csv (goal, rows, cols, cells, correlation, the Laplace\n"
     "mean of the goal as resampled to the mesh for each alpha_L, steps, seconds,\n"
@@ -45,7 +46,13 @@ constexpr const char* kSweepUsage =
     "  --up-axis A         meshes' up axis (default: each mesh's sidecar JSON \"up_axis\", else z)\n"
     "  --view-resolution N pixels of a mesh's top view along its longer side (default 256)\n"
     "  --encoding E        PNG pixels: grey (default), terrain-rgb or terrarium\n"
-    "  --no-sidecar        ignore NAME.json beside a goal (orientation, georef)\n";
+    "  --no-sidecar        ignore NAME.json beside a goal (orientation, georef)\n"
+    "  --align             plan each goal aligned (as plan --align): correlation is the\n"
+    "                      aligned goal's; sweep.csv gains align_shift_x_cells,\n"
+    "                      align_shift_y_cells, align_scale, unaligned_correlation,\n"
+    "                      align_gain, unaligned_seconds and align_planned\n"
+    "  --align-pick P      cost (default: the windows of lowest valley cost) or random\n"
+    "                      (a control: as many windows at random, seeded); implies --align\n";
 static_assert(std::string_view(kDefaultPlanner) == "algorithm2", "kSweepUsage names the default planner");
 
 struct SweepArgs {
@@ -88,6 +95,15 @@ SweepArgs parse_sweep_args(const std::vector<std::string>& args) {
     } else if (a == "--view-resolution") out.import.mesh_resolution = parse_int(a, value(), 1, 8192);
     else if (a == "--encoding") out.import.encoding = parse_pixel_encoding(value());
     else if (a == "--no-sidecar") out.import.sidecar = false;
+    else if (a == "--align") {
+      if (!out.options.align) out.options.align = AlignedPlanOptions{};
+    } else if (a == "--align-pick") {
+      const std::string pick = value();
+      if (pick != "cost" && pick != "random")
+        throw std::invalid_argument("--align-pick needs cost or random, got \"" + pick + "\"");
+      if (!out.options.align) out.options.align = AlignedPlanOptions{};
+      out.options.align->pick = pick == "random" ? AlignedPlanOptions::Pick::kRandom : AlignedPlanOptions::Pick::kValleyCost;
+    }
     else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option " + a);
     else out.goals.push_back(a);
   }
@@ -155,7 +171,11 @@ int sweep(const SweepArgs& args) {
     std::ofstream csv(out / "sweep.csv");
     csv << "goal,rows,cols,cells,correlation";
     for (double a : alphas) csv << ",laplace_mean_" << alpha_name(a);
-    csv << ",steps,refused,relief_mm,seconds,status,detail\n" << std::setprecision(6);
+    csv << ",steps,refused,relief_mm,seconds,status,detail";
+    if (args.options.align)
+      csv << ",align_shift_x_cells,align_shift_y_cells,align_scale,unaligned_correlation,align_gain,unaligned_seconds,"
+             "align_planned";
+    csv << "\n" << std::setprecision(6);
     for (const auto& r : rows) {
       csv << csv_field(r.goal) << "," << r.rows << "," << r.cols << "," << r.cells() << ",";
       if (r.correlation) csv << *r.correlation;
@@ -164,7 +184,21 @@ int sweep(const SweepArgs& args) {
         if (k < r.laplace_mean.size()) csv << r.laplace_mean[k];
       }
       csv << "," << r.steps << "," << r.refused << "," << r.relief_mm << "," << r.seconds << "," << r.status << ","
-          << csv_field(r.detail) << "\n";
+          << csv_field(r.detail);
+      if (args.options.align) {
+        csv << ",";
+        if (r.align) {
+          const GoalTransform& t = r.align->transform;
+          csv << t.shift_x_cells << "," << t.shift_y_cells << "," << t.scale << ",";
+          if (r.align->unaligned_correlation) csv << *r.align->unaligned_correlation;
+          csv << ",";
+          if (r.align->unaligned_correlation && r.correlation) csv << *r.correlation - *r.align->unaligned_correlation;
+          csv << "," << r.align->unaligned_seconds << "," << r.align->planned;
+        } else {
+          csv << ",,,,,,";
+        }
+      }
+      csv << "\n";
     }
   }
   const auto t2 = table2(rows, alphas);

@@ -70,6 +70,7 @@ void SweepOptions::validate() const {
   for (double a : alphas)
     if (!(a >= 0.0 && a <= 1.0)) throw std::invalid_argument("SweepOptions.alphas must lie in [0, 1]");
   (void)make_planner(planner);  // names the known planners if unknown
+  if (align) align->validate();
 }
 
 namespace {
@@ -86,24 +87,44 @@ SweepRow run_one(const SweepGoal& goal, ArraySize size, const SweepOptions& opti
     const ArrayGeometry geometry{size.rows, size.cols, 0.038, options.segments};
     const Mesh mesh(geometry);
     row.relief_mm = relief_or_default_mm(options.max_height_mm, geometry);
-    PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),
-                        resample_to_mesh(goal.map, mesh, row.relief_mm), {}, goal.map.z};
-    for (double a : options.alphas) row.laplace_mean.push_back(laplace_mean(request.goal_mm, a));
+    PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry), {}, {}, goal.map.z};
     PlanCallbacks callbacks;
-    callbacks.cancelled = [&] { return elapsed() > options.budget_s; };
-    const PlanResult result = make_planner(options.planner)->plan(request, callbacks);
+    // Aligned, a row plans up to 1 + plans goals one after the other, each within the budget.
+    const double budget_s = options.budget_s * (options.align ? 1 + options.align->plans : 1);
+    callbacks.cancelled = [&] { return elapsed() > budget_s; };
+    PlanResult result;
+    const HeightMap* scored_goal = &goal.map;
+    std::optional<AlignedPlan> aligned;
+    if (options.align) {
+      AlignedPlanOptions align = *options.align;
+      align.threads = 1;  // the sweep's pool is busy already
+      const Region whole{0.0, 0.0, double(goal.map.z.cols()), double(goal.map.z.rows()), false};
+      aligned = plan_aligned(options.planner, goal.map, whole, request, row.relief_mm, align, callbacks);
+      request.goal_mm = aligned->chosen.goal_mm;
+      for (double a : options.alphas) row.laplace_mean.push_back(laplace_mean(request.goal_mm, a));
+      scored_goal = &aligned->goal;
+      result = std::move(aligned->result);
+      row.align = SweepAlignment{aligned->chosen.transform,
+                                 std::isfinite(aligned->unaligned_score) ? std::optional(aligned->unaligned_score)
+                                                                         : std::nullopt,
+                                 aligned->planned.front().seconds, int(aligned->planned.size())};
+    } else {
+      request.goal_mm = resample_to_mesh(goal.map, mesh, row.relief_mm);
+      for (double a : options.alphas) row.laplace_mean.push_back(laplace_mean(request.goal_mm, a));
+      result = make_planner(options.planner)->plan(request, callbacks);
+    }
     row.steps = int(result.steps.size());
     row.refused = int(result.refused.size());
     // Mesh rows run along +y; the goal image's row 0 is its top.
     const Eigen::MatrixXd predicted_image = (point_heights(mesh, result.final_state.x) * 1000.0).colwise().reverse();
-    const Correlation corr = correlate_with_goal(goal.map.z, predicted_image);
+    const Correlation corr = correlate_with_goal(scored_goal->z, predicted_image);
     row.correlation = corr.value;
     row.status = corr.value ? "ok" : "undefined";
     row.detail = corr.undefined_reason;
   } catch (const PlanCancelled&) {
     row.status = "over-budget";
     std::ostringstream s;
-    s << "stopped after " << options.budget_s << " s (budget)";
+    s << "stopped after " << elapsed() << " s (budget " << options.budget_s << " s a plan)";
     row.detail = s.str();
   } catch (const std::exception& e) {
     row.status = "failed";

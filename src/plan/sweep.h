@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "metrics/laplace_predictor.h"
+#include "plan/aligned_plan.h"
 #include "plan/default_planner.h"
 #include "shapes/height_map.h"
 
@@ -43,8 +44,20 @@ struct SweepOptions {
   int jobs = 0;            // threads; 0 = std::thread::hardware_concurrency()
   double budget_s = 120.0;  // per plan; checked between actions (a settle in progress is not interrupted)
   std::vector<double> alphas = table2_alphas();
+  // Set: every goal planned aligned (plan_aligned, its plans one after the
+  // other in the sweep's thread; a row's budget is then budget_s times the
+  // number of goals it may plan, 1 + plans).
+  std::optional<AlignedPlanOptions> align;
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
+};
+
+// What alignment chose for a row (SweepOptions::align).
+struct SweepAlignment {
+  GoalTransform transform;
+  std::optional<double> unaligned_correlation;
+  double unaligned_seconds = 0.0;  // the unaligned goal's plan alone
+  int planned = 0;                 // goals planned, the unaligned one included
 };
 
 struct SweepRow {
@@ -58,6 +71,7 @@ struct SweepRow {
   double seconds = 0.0;
   std::string status;  // "ok", "undefined" (correlation undefined), "over-budget", "failed"
   std::string detail;  // the error or the reason the correlation is undefined
+  std::optional<SweepAlignment> align;  // with SweepOptions::align; correlation is then the aligned goal's
   int cells() const { return rows * cols; }
 };
 

@@ -79,7 +79,7 @@ LonLatBox parse_lonlat_box(const std::string& text) {
   return b;
 }
 
-HeightMap crop_lonlat(const HeightMap& map, const LonLatBox& box) {
+Region lonlat_pixel_region(const HeightMap& map, const LonLatBox& box) {
   if (!map.georef)
     throw std::invalid_argument("goal \"" + map.source +
                                 "\" is not georeferenced (a GeoTIFF, an SRTM .hgt tile or a CSV whose sidecar JSON has "
@@ -128,7 +128,11 @@ HeightMap crop_lonlat(const HeightMap& map, const LonLatBox& box) {
   pixels.y0 = std::max(0.0, std::floor(y_min + kSlack));
   pixels.x1 = std::min(cols, std::max(pixels.x0 + 1, std::ceil(x_max - kSlack)));
   pixels.y1 = std::min(rows, std::max(pixels.y0 + 1, std::ceil(y_max - kSlack)));
-  HeightMap out = crop(map, pixels);
+  return pixels;
+}
+
+HeightMap crop_lonlat(const HeightMap& map, const LonLatBox& box) {
+  HeightMap out = crop(map, lonlat_pixel_region(map, box));
   out.source += " [" + describe(box) + "]";
   return out;
 }

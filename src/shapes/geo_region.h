@@ -6,6 +6,7 @@
 #include <string>
 
 #include "shapes/height_map.h"
+#include "shapes/region.h"
 
 namespace hj {
 
@@ -27,5 +28,8 @@ LonLatBox parse_lonlat_box(const std::string& text);
 //         (the message gives the data's extent in longitude / latitude), or
 //         the region holds only no-data pixels.
 HeightMap crop_lonlat(const HeightMap& map, const LonLatBox& box);
+// The pixel region crop_lonlat takes (fractions = false); throws as it does,
+// except for a region of only no-data pixels (crop() finds those).
+Region lonlat_pixel_region(const HeightMap& map, const LonLatBox& box);
 
 }  // namespace hj

@@ -67,6 +67,16 @@ Region parse_region(const std::string& text) {
   return r;
 }
 
+Region pixel_region(const Region& region, long rows, long cols) {
+  check_region(region);
+  if (!region.fractions && (region.x1 > double(cols) || region.y1 > double(rows)))
+    throw std::invalid_argument("region " + describe(region) + " reaches outside the goal of " +
+                                std::to_string(cols) + " x " + std::to_string(rows) + " pixels");
+  const Span x = region.fractions ? fraction_span(region.x0, region.x1, cols) : Span{long(region.x0), long(region.x1)};
+  const Span y = region.fractions ? fraction_span(region.y0, region.y1, rows) : Span{long(region.y0), long(region.y1)};
+  return Region{double(x.begin), double(y.begin), double(x.end), double(y.end), false};
+}
+
 HeightMap crop(const HeightMap& map, const Region& region) {
   check_region(region);
   const long rows = map.z.rows(), cols = map.z.cols();
@@ -74,8 +84,8 @@ HeightMap crop(const HeightMap& map, const Region& region) {
   if (!region.fractions && (region.x1 > double(cols) || region.y1 > double(rows)))
     throw std::invalid_argument("region " + describe(region) + " reaches outside goal \"" + map.source + "\" of " +
                                 std::to_string(cols) + " x " + std::to_string(rows) + " pixels");
-  const Span x = region.fractions ? fraction_span(region.x0, region.x1, cols) : Span{long(region.x0), long(region.x1)};
-  const Span y = region.fractions ? fraction_span(region.y0, region.y1, rows) : Span{long(region.y0), long(region.y1)};
+  const Region px = pixel_region(region, rows, cols);
+  const Span x{long(px.x0), long(px.x1)}, y{long(px.y0), long(px.y1)};
   HeightMap out = map;  // keeps units, uncovered_height and georef
   out.z = map.z.block(y.begin, x.begin, y.end - y.begin, x.end - x.begin);
   if (out.georef) {

@@ -25,6 +25,11 @@ struct Region {
 //         numbers, negative, x1 <= x0 or y1 <= y0, fractional pixel indices.
 Region parse_region(const std::string& text);
 
+// The pixels crop() takes for `region` from an image of rows x cols: a
+// pixel region (fractions = false) of whole-number bounds.
+// @throws std::invalid_argument as crop() does for a bad or outside region.
+Region pixel_region(const Region& region, long rows, long cols);
+
 // The part of `map` inside `region`; source gains " [crop x0,y0,x1,y1]".
 // Units, uncovered_height and the georeference (its origin moved to the
 // crop's corner) are kept.
