@@ -18,9 +18,9 @@ bool contains(const std::vector<std::string>& names, const std::string& name) {
 }
 
 LeastSquaresResult fit(const Dataset& dataset, const ModelParams& start, const OnTheFlyOptions& options,
-                       int& replays) {
+                       int max_iterations, int& replays) {
   LeastSquaresOptions ls;
-  ls.max_iterations = options.max_iterations;
+  ls.max_iterations = max_iterations;
   ls.replay = fitting_replay(options.replay);
   LeastSquaresResult out = fit_least_squares(dataset, start, on_the_fly_parameters(start, options), ls);
   replays += out.evaluations + out.jacobians * out.free_parameters;
@@ -35,16 +35,18 @@ std::string judged(const std::string& effect, const LeastSquaresResult& trial, c
   return text;
 }
 
-// The candidate on top of `current`: its start scanned (effect_scan.h, as
-// diagnose does: a fit from the neutral value can stop far from the data),
-// then every parameter refitted.
+// The candidate on top of `current`: its start scanned coarsely
+// (effect_scan.h, as diagnose does: a fit from the neutral value can stop
+// far from the data), then every parameter refitted briefly.
 LeastSquaresResult try_candidate(const Dataset& dataset, const LeastSquaresResult& current, const std::string& effect,
                                  const OnTheFlyOptions& options, int& replays) {
   const ModelParams start = with_effects(current.params, {effect});
+  EffectScanOptions coarse;
+  coarse.fractions = options.scan_fractions;
   const EffectScan scan =
-      scan_effect_start(dataset, start, on_the_fly_parameters(start, options), effect, options.replay);
+      scan_effect_start(dataset, start, on_the_fly_parameters(start, options), effect, options.replay, coarse);
   replays += scan.replays;
-  return fit(dataset, scan.best, options, replays);
+  return fit(dataset, scan.best, options, options.trial_iterations, replays);
 }
 
 }  // namespace
@@ -75,6 +77,10 @@ MeasuredSession run_session(const std::string& name, const SessionDevice& device
 
 void OnTheFlyOptions::validate() const {
   if (max_iterations < 1) throw std::invalid_argument("on-the-fly calibration: max_iterations must be >= 1");
+  if (trial_iterations < 1) throw std::invalid_argument("on-the-fly calibration: trial_iterations must be >= 1");
+  for (double f : scan_fractions)
+    if (!(f > 0.0 && f <= 1.0))
+      throw std::invalid_argument("on-the-fly calibration: scan_fractions must lie in (0, 1]");
   if (!(min_fit_gain >= 0.0 && min_fit_gain < 1.0))
     throw std::invalid_argument("on-the-fly calibration: min_fit_gain must be in [0, 1)");
   if (!(max_delta_bic <= 0.0)) throw std::invalid_argument("on-the-fly calibration: max_delta_bic must be <= 0");
@@ -99,30 +105,35 @@ std::vector<FitParameter> on_the_fly_parameters(const ModelParams& params, const
 OnTheFlyFit calibrate_on_the_fly(const Dataset& dataset, const ModelParams& start, const OnTheFlyOptions& options) {
   options.validate();
   OnTheFlyFit out;
-  LeastSquaresResult current = fit(dataset, start, options, out.replays);
-  for (;;) {
-    // Each candidate not yet in the model, on top of it; the best significant one is added.
-    std::optional<LeastSquaresResult> best;
-    std::string best_effect;
-    for (const auto& effect : options.candidates) {
-      if (contains(current.params.effects, effect)) continue;
-      try {
-        LeastSquaresResult trial = try_candidate(dataset, current, effect, options, out.replays);
-        const bool significant = bic(trial) - bic(current) < options.max_delta_bic &&
-                                 trial.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm;
-        out.notes.push_back(judged(effect, trial, current, significant));
-        if (significant && (!best || bic(trial) < bic(*best))) best = std::move(trial), best_effect = effect;
-      } catch (const SettleInterrupted&) {
-        throw;
-      } catch (const std::exception& e) {
-        out.notes.push_back(effect + ": not fitted (" + e.what() + ")");
-      }
+  LeastSquaresResult current = fit(dataset, start, options, options.max_iterations, out.replays);
+  // Each candidate not yet in the model, alone on top of it (a short fit).
+  ModelParams joint = current.params;
+  std::optional<LeastSquaresResult> only;  // the one significant trial, if there is only one
+  for (const auto& effect : options.candidates) {
+    if (contains(current.params.effects, effect)) continue;
+    try {
+      LeastSquaresResult trial = try_candidate(dataset, current, effect, options, out.replays);
+      const bool significant = bic(trial) - bic(current) < options.max_delta_bic &&
+                               trial.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm;
+      out.notes.push_back(judged(effect, trial, current, significant));
+      if (!significant) continue;
+      // The trial's values of the effect's own parameters start the joint fit.
+      joint = with_effects(joint, {effect});
+      joint.effect_parameters[effect] = trial.params.effect_parameters.at(effect);
+      out.added.push_back(effect);
+      only = out.added.size() == 1 ? std::optional(std::move(trial)) : std::nullopt;
+    } catch (const SettleInterrupted&) {
+      throw;
+    } catch (const std::exception& e) {
+      out.notes.push_back(effect + ": not fitted (" + e.what() + ")");
     }
-    if (!best) break;
-    current = std::move(*best);
-    out.added.push_back(best_effect);
-    out.notes.push_back("added " + best_effect);
   }
+  // Every significant candidate added at once, fitted jointly (one fit
+  // rather than diagnose's greedy rounds, each of which refits every
+  // remaining candidate).
+  if (out.added.size() > 1) current = fit(dataset, joint, options, options.max_iterations, out.replays);
+  else if (only) current = std::move(*only);
+  for (const auto& e : out.added) out.notes.push_back("added " + e);
   out.params = current.params;
   out.estimates = current.estimates;
   out.rmse_mm = current.rmse_mm;

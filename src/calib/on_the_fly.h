@@ -1,9 +1,11 @@
 // Calibration on the fly (docs/render.md, correction "model"): the runs of a
 // render job, each from rest (a plan's actions, then one capture), form a
 // measurement dataset; the device model is fitted on it, with the optional
-// effects a small greedy selection adds (diagnose's rule, delta BIC and an
-// in-sample gain, without its cross-validation: the first iterations hold
-// only one or two sessions). A planner then plans with the fitted model.
+// effects a small selection adds: each candidate is tried alone on top of
+// the current model, and those significant by diagnose's rule (delta BIC and
+// an in-sample gain; not its cross-validation: the first iterations hold
+// only one or two sessions) are added together and fitted jointly. A planner
+// then plans with the fitted model.
 #pragma once
 
 #include <Eigen/Core>
@@ -28,7 +30,11 @@ struct OnTheFlyOptions {
   // Optional effects the selection may add, tried in this order on top of
   // the current model; one the start already has is refitted, not tried.
   std::vector<std::string> candidates = {"sensor_tilt", "stiffening", "cell_stiffness"};
-  int max_iterations = 6;  // Levenberg-Marquardt iterations of each fit
+  int max_iterations = 5;    // Levenberg-Marquardt iterations of the model's fit
+  int trial_iterations = 3;  // and of each candidate's trial
+  // Where a candidate's parameters are scanned before its trial (shares of
+  // the way to each bound, effect_scan.h): coarser than diagnose's.
+  std::vector<double> scan_fractions = {0.01, 0.1, 0.3, 0.7};
   // A candidate is added when its refit lowers BIC by more than
   // -max_delta_bic and the RMSE by at least min_fit_gain of the current's.
   double max_delta_bic = -10.0;
@@ -41,7 +47,7 @@ struct OnTheFlyOptions {
 
 struct OnTheFlyFit {
   ModelParams params;                        // the fitted model (the start's effects and those added)
-  std::vector<std::string> added;            // effects the selection added, in order
+  std::vector<std::string> added;            // effects added, in the order tried
   std::vector<ParameterEstimate> estimates;  // of every fitted parameter
   double rmse_mm = 0.0;
   long samples = 0;
@@ -54,8 +60,8 @@ struct OnTheFlyFit {
 // of each of its effects that is a candidate (the others are held).
 std::vector<FitParameter> on_the_fly_parameters(const ModelParams& params, const OnTheFlyOptions& options);
 
-// Fits `start` (its candidate effects refitted), then adds candidates
-// greedily while one is significant.
+// Fits `start` (its candidate effects refitted), tries each candidate it
+// lacks alone on top, and fits the model again with every significant one.
 // @throws std::invalid_argument (bad options, a dataset without samples, an
 //         unknown name), std::runtime_error if the start does not replay
 //         the dataset; SettleInterrupted when options.replay.interrupted says so.
