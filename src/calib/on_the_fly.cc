@@ -95,7 +95,9 @@ std::vector<FitParameter> on_the_fly_parameters(const ModelParams& params, const
     if (contains(options.candidates, e)) fitted_effects.push_back(e);
   std::vector<FitParameter> out;
   for (const FitParameter& p : fit_parameters(fitted_effects))
-    if (!p.surface || contains(options.surface_parameters, p.spec.name)) out.push_back(p);
+    if ((!p.surface || contains(options.surface_parameters, p.spec.name)) &&
+        !contains(options.held, p.qualified_name()))
+      out.push_back(p);
   for (const auto& name : options.surface_parameters)
     if (std::none_of(out.begin(), out.end(), [&](const FitParameter& p) { return p.surface && p.spec.name == name; }))
       throw std::invalid_argument("on-the-fly calibration: \"" + name + "\" is not a baseline parameter");

@@ -30,6 +30,12 @@ struct OnTheFlyOptions {
   // Optional effects the selection may add, tried in this order on top of
   // the current model; one the start already has is refitted, not tried.
   std::vector<std::string> candidates = {"sensor_tilt", "stiffening", "cell_stiffness"};
+  // Parameters of those effects held at the start's value (qualified
+  // names). A stiffness gradient domes one side higher, as a camera tilt
+  // seems to: on two captures of a tilted camera the fit traded them
+  // (tilt_x 13.0 against the true 15 mrad, grad_x -0.10 on a device without
+  // one), so only cell_stiffness' bulge (a soft or stiff middle) is fitted.
+  std::vector<std::string> held = {"cell_stiffness.grad_x", "cell_stiffness.grad_y"};
   int max_iterations = 5;    // Levenberg-Marquardt iterations of the model's fit
   int trial_iterations = 3;  // and of each candidate's trial
   // Where a candidate's parameters are scanned before its trial (shares of
@@ -57,7 +63,7 @@ struct OnTheFlyFit {
 };
 
 // The fitted parameters of `params`: options.surface_parameters, then those
-// of each of its effects that is a candidate (the others are held).
+// of each of its effects that is a candidate, less options.held.
 std::vector<FitParameter> on_the_fly_parameters(const ModelParams& params, const OnTheFlyOptions& options);
 
 // Fits `start` (its candidate effects refitted), tries each candidate it
