@@ -15,7 +15,7 @@ reads the true surface afterwards.
 
 Besides the table, one line per run lists the MAE and r of every iteration,
 its planning and fitting seconds and the model fitted last (correction
-model or both).
+model or both): on stderr as each run ends, and on stdout after the table.
 """
 import argparse
 import json
@@ -252,6 +252,7 @@ def main():
                           f"{below:.0f} % | {r['iterations']} ({r['best_iteration']}) | {run['true_mae_mm']:.2f} | "
                           f"{run['seconds']:.0f} |", flush=True)
                     details.append(f"{label}: " + detail(run))
+                    print(f"<!-- {details[-1]} -->", file=sys.stderr, flush=True)
                     runs.append({"size": size_text, "case": case, "goal": goal_name, "correction": correction, **run})
     print()
     for line in details:
