@@ -10,7 +10,12 @@ protocol line, read back with `truth` at the planner's mesh points, vented),
 starts hapticjam-server on it, runs `hapticjam remote render --json` and
 reads the true surface afterwards.
 
-  scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...] [--planner NAME]
+  scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...]
+                               [--corrections targets,model,both] [--planner NAME]
+
+Besides the table, one line per run lists the MAE and r of every iteration,
+its planning and fitting seconds and the model fitted last (correction
+model or both): on stderr as each run ends, and on stdout after the table.
 """
 import argparse
 import json
@@ -135,7 +140,7 @@ def start(argv, pattern, log):
     raise RuntimeError(f"{argv[0]} did not start: " + open(log + ".err").read())
 
 
-def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain, planner):
+def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain, planner, correction):
     rows, cols = size
     params = os.path.join(work, "device.json")
     with open(params, "w") as f:
@@ -165,7 +170,7 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
         address = f"127.0.0.1:{server_port}"
         cli = os.path.join(build, "hapticjam")
         for _ in range(300):
-            status = subprocess.run([cli, "remote", "status", "--json", "--server", address] + (["--gain", str(gain)] if gain else []), capture_output=True,
+            status = subprocess.run([cli, "remote", "status", "--json", "--server", address], capture_output=True,
                                     text=True)
             if status.returncode == 0 and json.loads(status.stdout).get("connected"):
                 break
@@ -174,7 +179,8 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
         render = subprocess.run([cli, "remote", "render", goal_file, "--rows", str(rows), "--cols", str(cols),
                                  "--segments", "4", "--iterations", str(iterations), "--heights", "absolute",
                                  "--json", "--server", address] + (["--gain", str(gain)] if gain else [])
-                                + (["--planner", planner] if planner else []), capture_output=True, text=True)
+                                + (["--planner", planner] if planner else [])
+                                + (["--correction", correction] if correction else []), capture_output=True, text=True)
         seconds = time.time() - started
         if render.returncode != 0:
             raise RuntimeError(f"render failed ({render.returncode}): {render.stderr}")
@@ -190,6 +196,21 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
                 proc.wait()
 
 
+def detail(run):
+    """Per iteration: MAE / r, planning + fitting seconds; then the last fitted model."""
+    parts = []
+    for it in run["iterations"]:
+        r = it.get("correlation")
+        parts.append(f"{it['mae_mm']:.2f} mm / {'-' if r is None else f'{r:.3f}'} "
+                     f"({it['planning_seconds']:.1f} + {it.get('fitting_seconds', 0.0):.1f} s)")
+    text = "; ".join(parts)
+    model = run["result"].get("model")
+    if model:
+        values = ", ".join(f"{k} {v:.4g}" for k, v in model["parameters"].items())
+        text += f"; model: effects [{', '.join(model['effects'])}], {values}, RMSE {model['rmse_mm']:.2f} mm"
+    return text
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build")
@@ -200,31 +221,42 @@ def main():
     ap.add_argument("--planner", default="", help="the server's planner for each iteration (default: the server's)")
     ap.add_argument("--noise-mm", type=float, default=1.0)
     ap.add_argument("--gain", type=float, default=0.0, help="of the target correction (0: the server's default)")
+    ap.add_argument("--corrections", default="targets",
+                    help="comma-separated: targets, model, both, none (each case runs with each)")
     ap.add_argument("--json-out", help="also write every run's figures here")
     args = ap.parse_args()
     runs = []
-    print("| array | device | goal | open loop MAE (mm) | closed loop MAE (mm) | r open / closed | below open loop | "
-          "iterations (best) | true surface MAE (mm) | render (s) |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| array | device | goal | correction | open loop MAE (mm) | closed loop MAE (mm) | r open / closed | "
+          "below open loop | iterations (best) | true surface MAE (mm) | render (s) |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    details = []
     for size_text in args.sizes.split(","):
         size = tuple(int(v) for v in size_text.split("x"))
         for case in args.cases.split(","):
             for goal_name in args.goals.split(","):
-                with tempfile.TemporaryDirectory(prefix="hj_render_") as work:
-                    try:
-                        run = run_case(args.build, work, case, size, goal_name, sequences(*size)[goal_name],
-                                       args.iterations, args.noise_mm, args.gain, args.planner)
-                    except RuntimeError as e:
-                        print(f"| {size_text} | {case} | {goal_name} | failed: {e} |||||||", flush=True)
-                        continue
-                r = run["result"]
-                below = 100.0 * (1 - r["mae_mm"] / r["open_loop_mae_mm"]) if r["open_loop_mae_mm"] > 0 else 0.0
-                corr = lambda v: "-" if v is None else f"{v:.3f}"
-                print(f"| {size_text} | {case} | {goal_name} | {r['open_loop_mae_mm']:.2f} | {r['mae_mm']:.2f} | "
-                      f"{corr(r.get('open_loop_correlation'))} / {corr(r['correlation'])} | {below:.0f} % | "
-                      f"{r['iterations']} ({r['best_iteration']}) | {run['true_mae_mm']:.2f} | {run['seconds']:.0f} |",
-                      flush=True)
-                runs.append({"size": size_text, "case": case, "goal": goal_name, **run})
+                for correction in args.corrections.split(","):
+                    label = f"{size_text} {case} {goal_name} {correction}"
+                    with tempfile.TemporaryDirectory(prefix="hj_render_") as work:
+                        try:
+                            run = run_case(args.build, work, case, size, goal_name, sequences(*size)[goal_name],
+                                           args.iterations, args.noise_mm, args.gain, args.planner, correction)
+                        except RuntimeError as e:
+                            print(f"| {size_text} | {case} | {goal_name} | {correction} | failed: {e} |||||||",
+                                  flush=True)
+                            continue
+                    r = run["result"]
+                    below = 100.0 * (1 - r["mae_mm"] / r["open_loop_mae_mm"]) if r["open_loop_mae_mm"] > 0 else 0.0
+                    corr = lambda v: "-" if v is None else f"{v:.3f}"
+                    print(f"| {size_text} | {case} | {goal_name} | {correction} | {r['open_loop_mae_mm']:.2f} | "
+                          f"{r['mae_mm']:.2f} | {corr(r.get('open_loop_correlation'))} / {corr(r['correlation'])} | "
+                          f"{below:.0f} % | {r['iterations']} ({r['best_iteration']}) | {run['true_mae_mm']:.2f} | "
+                          f"{run['seconds']:.0f} |", flush=True)
+                    details.append(f"{label}: " + detail(run))
+                    print(f"<!-- {details[-1]} -->", file=sys.stderr, flush=True)
+                    runs.append({"size": size_text, "case": case, "goal": goal_name, "correction": correction, **run})
+    print()
+    for line in details:
+        print("- " + line)
     if args.json_out:
         with open(args.json_out, "w") as f:
             json.dump(runs, f, indent=1)

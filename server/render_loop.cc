@@ -4,11 +4,14 @@
 #include <cmath>
 #include <sstream>
 
+#include "calib/measurement_effects.h"
 #include "calib/rasterize.h"
 #include "json_log.h"
 #include "metrics/height_error.h"
 #include "plan/planner.h"
+#include "render_calibration.h"
 #include "service_error.h"
+#include "sim/settle_report.h"
 
 namespace hj::server {
 
@@ -51,19 +54,49 @@ Eigen::MatrixXd frame_heights(const v1::CaptureFrame& frame) {
   return out;
 }
 
-// The predicted surface as the camera would see it at the rest points: like with like.
-Eigen::MatrixXd predicted_at_rest_points(const Mesh& mesh, const Eigen::Matrix3Xd& x, const v1::CaptureGrid& g) {
+SessionGrid session_grid(const v1::CaptureGrid& g) {
   SessionGrid grid;
   grid.nx = g.nx(), grid.ny = g.ny(), grid.x0_mm = g.x0_mm(), grid.y0_mm = g.y0_mm();
   grid.dx_mm = g.dx_mm(), grid.dy_mm = g.dy_mm();
-  return frame_at_rest_points(mesh, rasterize_top_view(mesh, x, grid), frame_grid(g));
+  return grid;
+}
+
+// The predicted surface as the camera would see it at the rest points: like with like.
+Eigen::MatrixXd predicted_at_rest_points(const Mesh& mesh, const Eigen::Matrix3Xd& x, const v1::CaptureGrid& g) {
+  return frame_at_rest_points(mesh, rasterize_top_view(mesh, x, session_grid(g)), frame_grid(g));
+}
+
+bool learns_targets(v1::RenderCorrection c) {
+  return c == v1::RENDER_CORRECTION_TARGETS || c == v1::RENDER_CORRECTION_BOTH;
+}
+bool fits_model(v1::RenderCorrection c) { return c == v1::RENDER_CORRECTION_MODEL || c == v1::RENDER_CORRECTION_BOTH; }
+
+// The request's model as a fit takes it: its surface and its effects with every value resolved.
+ModelParams model_of(const ArrayConfig& array) {
+  ModelParams out;
+  out.surface = array.params;
+  out.effects = array.simulator.extra_effects;
+  for (const auto& name : out.effects) {
+    const auto given = array.simulator.effect_parameters.find(name);
+    out.effect_parameters[name] = resolve_parameters(
+        EffectRegistry::instance().get(name),
+        given == array.simulator.effect_parameters.end() ? EffectParameterValues{} : given->second);
+  }
+  return out;
+}
+
+void camera_to_proto(const CameraPlane& plane, const std::string& source, v1::CameraPlane* out) {
+  out->set_tilt_x_mrad(plane.tilt_x_mrad), out->set_tilt_y_mrad(plane.tilt_y_mrad);
+  out->set_offset_mm(plane.offset_mm), out->set_points(plane.points);
+  out->set_source(source);
 }
 
 class RenderRun {
  public:
   RenderRun(const RenderSetup& setup, DeviceQueue& queue, const Caller& caller, const RenderHooks& hooks)
       : setup_(setup), queue_(queue), caller_(caller), hooks_(hooks), mesh_(setup.array.geometry),
-        targets_(setup.goal_mm) {}
+        targets_(setup.goal_mm),
+        calibration_(setup.array.geometry, model_of(setup.array), setup.fit_threads, hooks.cancelled) {}
 
   v1::RenderResult run() {
     check_device();
@@ -92,6 +125,7 @@ class RenderRun {
       emit_iteration(std::move(it));
       if (stopping) break;
     }
+    if (fits_model(setup_.correction)) *result.mutable_model() = last_model_;
     result.set_stop_reason(stop);
     result.set_seconds(seconds_since(start));
     return result;
@@ -123,7 +157,11 @@ class RenderRun {
   }
 
   PlanResult plan(int iteration) {
-    PlanRequest request{setup_.array.geometry, setup_.array.params, targets_, setup_.array.simulator, {}};
+    // The fitted model (the request's until a fit), its camera left out: a planner plans surfaces.
+    const ModelParams model = without_measurement_effects(calibration_.model());
+    SimulatorOptions simulator = setup_.array.simulator;
+    model.apply_to(simulator);
+    PlanRequest request{setup_.array.geometry, model.surface, targets_, simulator, {}};
     PlanCallbacks callbacks;
     callbacks.cancelled = hooks_.cancelled;
     callbacks.progress = [&](double fraction, const std::string& what) {
@@ -188,8 +226,10 @@ class RenderRun {
     }
     *it.mutable_capture() = job.captures(job.captures_size() - 1);
 
-    const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame_heights(it.capture()), frame_grid(it.capture().grid()));
-    const Eigen::MatrixXd measured = setup_.keep_camera_plane ? seen : calibrated(i, seen, it.mutable_camera());
+    const Eigen::MatrixXd frame = frame_heights(it.capture());
+    if (fits_model(setup_.correction)) fit_model(i, planned.steps, frame, it);
+    const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame, frame_grid(it.capture().grid()));
+    const Eigen::MatrixXd measured = calibrated(i, seen, it.mutable_camera());
     const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, planned.final_state.x, it.capture().grid());
     it.set_point_rows(mesh_.point_rows()), it.set_point_cols(mesh_.point_cols());
     add_heights(measured, it.mutable_measured_heights_mm());
@@ -201,33 +241,70 @@ class RenderRun {
     } catch (const std::invalid_argument& e) {
       throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
     }
-    it.set_correction(correct(measured));
+    it.set_correction(correct(measured, it));
     return it;
   }
 
-  // The capture with the camera's plane (fitted on the clamped edge) taken out.
+  // The device model refitted on every run so far, this one included;
+  // the next iteration plans with it.
+  void fit_model(int i, const std::vector<Action>& steps, const Eigen::MatrixXd& frame, v1::RenderIteration& it) {
+    progress(i, 0.95, "fitting the model on " + std::to_string(i) + " capture" + (i > 1 ? "s" : ""));
+    const auto start = Clock::now();
+    try {
+      calibration_.add_run_and_fit(i, steps, session_grid(it.capture().grid()), frame, it.mutable_model());
+    } catch (const SettleInterrupted&) {
+      throw ServiceError(StatusCode::CANCELLED, "the render was cancelled while fitting iteration " +
+                                                    std::to_string(i) + "'s model");
+    } catch (const std::exception& e) {
+      throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": the model fit failed: " +
+                                                  e.what());
+    }
+    it.set_fitting_seconds(seconds_since(start));
+    last_model_ = it.model();
+    log_event("render_fit", {{"iteration", i}, {"rmse_mm", it.model().rmse_mm()}, {"seconds", it.fitting_seconds()}});
+  }
+
+  // The capture with the camera's plane taken out: the fitted sensor_tilt
+  // where the model is fitted, else the plane fitted on the clamped edge.
   Eigen::MatrixXd calibrated(int i, const Eigen::MatrixXd& seen, v1::CameraPlane* out) {
+    if (setup_.keep_camera_plane) {
+      camera_to_proto({}, "none", out);
+      return seen;
+    }
+    if (fits_model(setup_.correction)) {
+      const CameraPlane plane = calibration_.camera();
+      const bool found = plane.tilt_x_mrad != 0.0 || plane.tilt_y_mrad != 0.0 || plane.offset_mm != 0.0;
+      camera_to_proto(plane, found ? "fitted sensor_tilt" : "none", out);
+      return without_camera_plane(mesh_, seen, plane);
+    }
     CameraPlane plane;
     try {
       plane = fit_camera_plane(mesh_, seen);
     } catch (const std::invalid_argument& e) {
       throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
     }
-    out->set_tilt_x_mrad(plane.tilt_x_mrad), out->set_tilt_y_mrad(plane.tilt_y_mrad);
-    out->set_offset_mm(plane.offset_mm), out->set_points(plane.points);
+    camera_to_proto(plane, "clamped edge", out);
     return without_camera_plane(mesh_, seen, plane);
   }
 
   // The next iteration's targets; what changed, for people.
-  std::string correct(const Eigen::MatrixXd& measured) {
+  std::string correct(const Eigen::MatrixXd& measured, const v1::RenderIteration& it) {
     if (setup_.correction == v1::RENDER_CORRECTION_NONE) return "none (open loop: the same targets again)";
-    const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, measured, setup_.gain);
-    const Eigen::ArrayXXd change = (next - targets_).array().abs();
-    targets_ = next;
     std::ostringstream s;
     s.precision(3);
-    s << "targets += " << setup_.gain << " x (goal - measured): mean |change| " << change.mean() << " mm, max "
-      << change.maxCoeff() << " mm";
+    if (fits_model(setup_.correction)) {
+      s << "plan with the fitted model (RMSE " << it.model().rmse_mm() << " mm on " << it.model().captures()
+        << " capture" << (it.model().captures() > 1 ? "s" : "") << "):";
+      for (const auto& p : it.model().parameters()) s << " " << p.name() << " " << p.value();
+    }
+    if (learns_targets(setup_.correction)) {
+      const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, measured, setup_.gain);
+      const Eigen::ArrayXXd change = (next - targets_).array().abs();
+      targets_ = next;
+      if (fits_model(setup_.correction)) s << "; ";
+      s << "targets += " << setup_.gain << " x (goal - measured): mean |change| " << change.mean() << " mm, max "
+        << change.maxCoeff() << " mm";
+    }
     return s.str();
   }
 
@@ -237,6 +314,8 @@ class RenderRun {
   const RenderHooks& hooks_;
   const Mesh mesh_;
   Eigen::MatrixXd targets_;
+  RenderCalibration calibration_;
+  v1::FittedModel last_model_;
 };
 
 }  // namespace

@@ -3,8 +3,9 @@
 // the device queue (every step checked against the device first; a cancel,
 // an emergency stop or a link drop ends the job and so the render), compare
 // the capture with the goal at the mesh points (metrics/height_error.h),
-// move the targets by the error (learned_targets) and repeat, until the
-// error stops falling or the iteration limit.
+// correct (move the targets by the error, learned_targets; or refit the
+// device model on the captures so far and plan with it, render_calibration.h;
+// or both) and repeat, until the error stops falling or the iteration limit.
 #pragma once
 
 #include <Eigen/Core>
@@ -29,6 +30,7 @@ struct RenderSetup {
   double gain = 1.5;
   std::string name = "render";
   bool keep_camera_plane = false;  // compare the captures without fitting the camera's plane out
+  int fit_threads = 0;             // of the model fit (MODEL, BOTH); 0: one per core
 };
 
 struct RenderHooks {

@@ -1,7 +1,9 @@
 #include "render_service.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "plan/planner.h"
 #include "render_loop.h"
@@ -39,13 +41,16 @@ RenderSetup setup_from_proto(const v1::RenderRequest& request, const MapStore& m
   switch (request.correction()) {
     case v1::RENDER_CORRECTION_UNSPECIFIED:
     case v1::RENDER_CORRECTION_TARGETS: setup.correction = v1::RENDER_CORRECTION_TARGETS; break;
-    case v1::RENDER_CORRECTION_NONE: setup.correction = v1::RENDER_CORRECTION_NONE; break;
+    case v1::RENDER_CORRECTION_NONE:
+    case v1::RENDER_CORRECTION_MODEL:
+    case v1::RENDER_CORRECTION_BOTH: setup.correction = request.correction(); break;
     default:
       throw ServiceError(StatusCode::INVALID_ARGUMENT,
                          "correction: unknown value " + std::to_string(request.correction()));
   }
   if (!request.name().empty()) setup.name = request.name();
   setup.keep_camera_plane = request.keep_camera_plane();
+  setup.fit_threads = calibration_thread_count(0, limits, int(std::max(1u, std::thread::hardware_concurrency())));
   return setup;
 }
 

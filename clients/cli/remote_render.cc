@@ -30,14 +30,18 @@ constexpr const char* kRenderUsage =
     "correct the targets by the error, and again, until the error stops falling or N\n"
     "iterations (docs/render.md). Needs the operator role.\n"
     "  --iterations N        runs at most (default 5, at most 20)\n"
-    "  --correction C        targets (default: learn the targets from the error) or none\n"
-    "                        (the open-loop plan again, a baseline)\n"
+    "  --correction C        targets (default: learn the targets from the error), model\n"
+    "                        (fit the device model on the captures so far and plan with it;\n"
+    "                        a fitted camera tilt is taken out of the captures), both, or\n"
+    "                        none (the open-loop plan again, a baseline)\n"
     "  --gain G              of the target correction, (0, 2] (default 1.5)\n"
     "  --keep-camera-plane   compare the captures as they come (default: the camera's tilt\n"
-    "                        and offset are fitted on the clamped edge and taken out)\n"
+    "                        and offset are fitted on the clamped edge, or with the model,\n"
+    "                        and taken out)\n"
     "  --name NAME           the device jobs' names (\"NAME iteration I\", default render)\n"
     "  --out DIR             DIR/goal.csv, DIR/result.json and per iteration DIR/iteration-I/\n"
     "                        plan.json, capture.csv, measured.csv, predicted.csv, targets.csv\n"
+    "                        (and model.json: the fitted model, with --correction model|both)\n"
     "  --json                one JSON object per iteration, then {\"result\": ...}\n";
 
 struct RemoteRenderArgs {
@@ -67,7 +71,9 @@ RemoteRenderArgs parse_render(const std::vector<std::string>& args) {
       const std::string& v = c.value();
       if (v == "targets") out.correction = v1::RENDER_CORRECTION_TARGETS;
       else if (v == "none") out.correction = v1::RENDER_CORRECTION_NONE;
-      else throw std::invalid_argument("--correction needs targets or none, got \"" + v + "\"");
+      else if (v == "model") out.correction = v1::RENDER_CORRECTION_MODEL;
+      else if (v == "both") out.correction = v1::RENDER_CORRECTION_BOTH;
+      else throw std::invalid_argument("--correction needs targets, model, both or none, got \"" + v + "\"");
     } else throw std::invalid_argument(a[0] == '-' ? "unknown option " + a : "unexpected argument \"" + a + "\"");
   }
   out.goal.validate();
@@ -81,6 +87,25 @@ Eigen::MatrixXd points(const google::protobuf::RepeatedField<double>& heights, i
   return goal_heights(heights, rows, cols);
 }
 
+// {"effects": [...], "parameters": {"spring_k": 61.2, ...}, "rmse_mm": ..., ...}; null without a fit.
+nlohmann::json model_json(const v1::FittedModel& m) {
+  if (m.captures() == 0) return nullptr;
+  nlohmann::json parameters = nlohmann::json::object(), errors = nlohmann::json::object();
+  for (const auto& p : m.parameters()) {
+    parameters[p.name()] = p.value();
+    errors[p.name()] = number_or_null(std::isfinite(p.std_error()), p.std_error());
+  }
+  const auto strings = [](const auto& field) { return std::vector<std::string>(field.begin(), field.end()); };
+  return {{"effects", strings(m.effects())},
+          {"added", strings(m.added())},
+          {"parameters", parameters},
+          {"std_errors", errors},
+          {"rmse_mm", m.rmse_mm()},
+          {"captures", m.captures()},
+          {"replays", m.replays()},
+          {"notes", strings(m.notes())}};
+}
+
 void write_iteration(const fs::path& out, const v1::RenderIteration& it) {
   const fs::path dir = out / ("iteration-" + std::to_string(it.iteration()));
   fs::create_directories(dir);
@@ -90,6 +115,7 @@ void write_iteration(const fs::path& out, const v1::RenderIteration& it) {
   write_frame_csv(dir / "measured.csv", points(it.measured_heights_mm(), it.point_rows(), it.point_cols()));
   write_frame_csv(dir / "predicted.csv", points(it.predicted_heights_mm(), it.point_rows(), it.point_cols()));
   write_frame_csv(dir / "targets.csv", points(it.target_heights_mm(), it.point_rows(), it.point_cols()));
+  if (it.model().captures() > 0) std::ofstream(dir / "model.json") << model_json(it.model()).dump(1) << "\n";
 }
 
 nlohmann::json iteration_line(const v1::RenderIteration& it) {
@@ -101,6 +127,9 @@ nlohmann::json iteration_line(const v1::RenderIteration& it) {
           {"prediction_mae_mm", it.prediction_error().mae_mm()},
           {"camera_tilt_mrad", {it.camera().tilt_x_mrad(), it.camera().tilt_y_mrad()}},
           {"camera_offset_mm", it.camera().offset_mm()},
+          {"camera_source", it.camera().source()},
+          {"model", model_json(it.model())},
+          {"fitting_seconds", it.fitting_seconds()},
           {"job_id", it.job_id()},
           {"planning_seconds", it.planning_seconds()},
           {"device_seconds", it.device_seconds()}};
@@ -117,6 +146,7 @@ nlohmann::json result_line(const v1::RenderResult& r) {
              number_or_null(r.open_loop_error().has_correlation(), r.open_loop_error().correlation())},
             {"best_iteration", r.best_iteration()},
             {"stop_reason", r.stop_reason()},
+            {"model", model_json(r.model())},
             {"seconds", r.seconds()}}}};
 }
 

@@ -9,17 +9,29 @@ namespace hj {
 namespace {
 
 MeasuredSession read_measured_session(const std::filesystem::path& dir) {
+  Session session = read_session(dir);
+  return measured_session(std::move(session), [&](const Session& s, const SessionStep& step) {
+    return read_frame_csv(s.frame_path(step), s.grid.ny, s.grid.nx);
+  });
+}
+
+bool same_device(const SessionDevice& a, const SessionDevice& b) {
+  return a.rows == b.rows && a.cols == b.cols && a.cell_size_mm == b.cell_size_mm;
+}
+
+}  // namespace
+
+MeasuredSession measured_session(Session session,
+                                 const std::function<Eigen::MatrixXd(const Session&, const SessionStep&)>& frame) {
   MeasuredSession out;
-  out.session = read_session(dir);
+  out.session = std::move(session);
   const SessionDevice& device = out.session.device;
   double pressure_pa = 0.0;
   std::vector<bool> jammed(device.rows * device.cols, false);
   std::vector<std::pair<int, int>> pinned;
   for (const SessionStep& step : out.session.steps) {
     if (step.kind == SessionStep::Kind::kCapture) {
-      out.captures.push_back({step.index, step.frame, step.label,
-                              read_frame_csv(out.session.frame_path(step), out.session.grid.ny, out.session.grid.nx),
-                              pressure_pa, jammed, pinned});
+      out.captures.push_back({step.index, step.frame, step.label, frame(out.session, step), pressure_pa, jammed, pinned});
       continue;
     }
     const Action& a = step.action;
@@ -36,12 +48,6 @@ MeasuredSession read_measured_session(const std::filesystem::path& dir) {
   }
   return out;
 }
-
-bool same_device(const SessionDevice& a, const SessionDevice& b) {
-  return a.rows == b.rows && a.cols == b.cols && a.cell_size_mm == b.cell_size_mm;
-}
-
-}  // namespace
 
 int MeasuredCapture::jammed_count() const { return static_cast<int>(std::count(jammed.begin(), jammed.end(), true)); }
 

@@ -39,6 +39,13 @@ struct Dataset {
   int capture_count() const;
 };
 
+// A session with its captures' frames (from `frame`, one per capture step,
+// (ny x nx)) and the device state each capture was taken in: how a dataset
+// is read from files, and how captures that never touched a disk (a render
+// job's, on_the_fly.h) become one.
+MeasuredSession measured_session(Session session,
+                                 const std::function<Eigen::MatrixXd(const Session&, const SessionStep&)>& frame);
+
 // Reads every sub-folder of `dir` that holds a session.json, and its frames.
 // @throws SessionError naming the folder if it holds no session, a session
 //         whose device differs from the first one's, or (from read_session

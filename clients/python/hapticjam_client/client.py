@@ -191,9 +191,12 @@ class Client:
         """Renders `goal` on the server's device with the loop closed (docs/render.md):
         plan, run, capture, compare with the goal, correct the targets, again.
         on_event(RenderEvent) sees every progress and iteration event.
-        correction: "targets" (learn the targets from the error) or "none" (open loop).
+        correction: "targets" (learn the targets from the error), "model" (fit the device
+        model on the captures so far and plan with it), "both", or "none" (open loop).
         Returns (RenderResult, [RenderIteration, ...])."""
         corrections = {"targets": render_service_pb2.RENDER_CORRECTION_TARGETS,
+                       "model": render_service_pb2.RENDER_CORRECTION_MODEL,
+                       "both": render_service_pb2.RENDER_CORRECTION_BOTH,
                        "none": render_service_pb2.RENDER_CORRECTION_NONE}
         if correction not in corrections:
             raise ValueError(f"correction must be one of {sorted(corrections)}, got {correction!r}")
