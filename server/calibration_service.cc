@@ -13,6 +13,7 @@
 #include "calib/fit_model.h"
 #include "calib/fit_parameters.h"
 #include "dataset_upload.h"
+#include "fitted_parameter_proto.h"
 #include "request_context.h"
 #include "service_error.h"
 #include "streamed_work.h"
@@ -148,19 +149,7 @@ Dataset sessions_named(const Dataset& dataset, const std::vector<std::string>& n
 }
 
 void add_parameters(const LeastSquaresResult& fit, google::protobuf::RepeatedPtrField<v1::FittedParameter>* out) {
-  for (const auto& e : fit.estimates) {
-    v1::FittedParameter* p = out->Add();
-    p->set_name(e.parameter.qualified_name());
-    p->set_value(e.value);
-    p->set_unit(e.parameter.spec.unit);
-    p->set_active(e.active);
-    if (!e.active) continue;
-    p->set_std_error(e.std_error);
-    p->set_ci95_low(e.ci95_low);
-    p->set_ci95_high(e.ci95_high);
-    p->set_interval_method(e.interval_method);
-    p->set_loose(e.loose);
-  }
+  for (const auto& e : fit.estimates) estimate_to_proto(e, out->Add());
 }
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }

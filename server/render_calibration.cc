@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "fitted_parameter_proto.h"
+
 namespace hj::server {
 
 namespace v1 = ::hapticjam::v1;
@@ -39,19 +41,7 @@ CameraPlane RenderCalibration::camera() const {
 }
 
 void fitted_model_to_proto(const OnTheFlyFit& fit, v1::FittedModel* out) {
-  for (const ParameterEstimate& e : fit.estimates) {
-    v1::FittedParameter* p = out->add_parameters();
-    p->set_name(e.parameter.qualified_name());
-    p->set_value(e.value);
-    p->set_unit(e.parameter.spec.unit);
-    p->set_active(e.active);
-    if (!e.active) continue;
-    p->set_std_error(e.std_error);
-    p->set_ci95_low(e.ci95_low);
-    p->set_ci95_high(e.ci95_high);
-    p->set_interval_method(e.interval_method);
-    p->set_loose(e.loose);
-  }
+  for (const ParameterEstimate& e : fit.estimates) estimate_to_proto(e, out->add_parameters());
   for (const auto& e : fit.params.effects) out->add_effects(e);
   for (const auto& e : fit.added) out->add_added(e);
   out->set_rmse_mm(fit.rmse_mm);

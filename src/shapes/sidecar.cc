@@ -81,21 +81,38 @@ HeightMap reorient(const HeightMap& map, const std::string& numpy_expression) {
   return out;
 }
 
-void apply_sidecar(const std::filesystem::path& goal_file, HeightMap& map) {
-  const auto sidecar = goal_file.parent_path() / (goal_file.stem().string() + ".json");
-  if (goal_file.extension() == ".json" || !std::filesystem::is_regular_file(sidecar)) return;
-  const auto fail = [&](const std::string& what) {
-    throw ImportError(goal_file, "its sidecar \"" + sidecar.string() + "\" " + what +
-                                     " (ImportOptions.sidecar = false / plan --no-sidecar ignores it)");
-  };
+namespace {
+
+// NAME.json beside `goal_file`, parsed, with what to throw for it; empty
+// when there is none.
+struct Sidecar {
+  std::filesystem::path goal_file, file;
   nlohmann::json doc;
-  try {
-    std::ifstream in(sidecar);
-    doc = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    fail(std::string("is not valid JSON: ") + e.what());
+  [[noreturn]] void fail(const std::string& what) const {
+    throw ImportError(goal_file, "its sidecar \"" + file.string() + "\" " + what +
+                                     " (ImportOptions.sidecar = false / --no-sidecar ignores it)");
   }
-  if (!doc.is_object()) return;
+};
+
+std::optional<Sidecar> read_sidecar(const std::filesystem::path& goal_file) {
+  Sidecar out{goal_file, goal_file.parent_path() / (goal_file.stem().string() + ".json"), {}};
+  if (goal_file.extension() == ".json" || !std::filesystem::is_regular_file(out.file)) return std::nullopt;
+  try {
+    std::ifstream in(out.file);
+    out.doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    out.fail(std::string("is not valid JSON: ") + e.what());
+  }
+  return out;
+}
+
+}  // namespace
+
+void apply_sidecar(const std::filesystem::path& goal_file, HeightMap& map) {
+  const std::optional<Sidecar> sidecar = read_sidecar(goal_file);
+  if (!sidecar || !sidecar->doc.is_object()) return;
+  const nlohmann::json& doc = sidecar->doc;
+  const auto fail = [&](const std::string& what) { sidecar->fail(what); };
   try {
     if (!map.georef && doc.contains("georef") && doc["georef"].is_object() && doc["georef"].contains("geotransform")) {
       const auto& g = doc.at("georef");
@@ -115,7 +132,7 @@ void apply_sidecar(const std::filesystem::path& goal_file, HeightMap& map) {
       const std::string expr = doc["orientation"].at("north_up_numpy").get<std::string>();
       map = reorient(map, expr);
       if (without_blanks(expr.substr(0, expr.find_first_of("(#"))) != "a")
-        map.source += " [north-up by " + sidecar.filename().string() + "]";
+        map.source += " [north-up by " + sidecar->file.filename().string() + "]";
     }
   } catch (const nlohmann::json::exception& e) {
     fail(std::string("has a key of the wrong type: ") + e.what());
@@ -125,20 +142,10 @@ void apply_sidecar(const std::filesystem::path& goal_file, HeightMap& map) {
 }
 
 std::optional<std::pair<char, bool>> sidecar_up_axis(const std::filesystem::path& mesh_file) {
-  const auto sidecar = mesh_file.parent_path() / (mesh_file.stem().string() + ".json");
-  if (mesh_file.extension() == ".json" || !std::filesystem::is_regular_file(sidecar)) return std::nullopt;
-  const auto fail = [&](const std::string& what) {
-    throw ImportError(mesh_file, "its sidecar \"" + sidecar.string() + "\" " + what +
-                                     " (--up-axis, or --no-sidecar to ignore the sidecar)");
-  };
-  nlohmann::json doc;
-  try {
-    std::ifstream in(sidecar);
-    doc = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    fail(std::string("is not valid JSON: ") + e.what());
-  }
-  if (!doc.is_object() || !doc.contains("up_axis")) return std::nullopt;
+  const std::optional<Sidecar> sidecar = read_sidecar(mesh_file);
+  if (!sidecar || !sidecar->doc.is_object() || !sidecar->doc.contains("up_axis")) return std::nullopt;
+  const nlohmann::json& doc = sidecar->doc;
+  const auto fail = [&](const std::string& what) { sidecar->fail(what); };
   if (!doc["up_axis"].is_string()) fail("has an \"up_axis\" that is not a string");
   const std::string text = doc["up_axis"];
   std::size_t at = 0;
