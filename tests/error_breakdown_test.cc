@@ -28,21 +28,24 @@ double share(const ErrorBreakdown& b, const std::string& name) {
   return 0.0;
 }
 
+// The error of `goal` against `predicted` lies (nearly) all in `place`, and it dominates.
+void expect_error_in(const Eigen::MatrixXd& goal, const Eigen::MatrixXd& predicted, const std::string& place) {
+  const ErrorBreakdown b = error_breakdown(kMesh, goal, predicted);
+  EXPECT_GT(share(b, place), 0.9);
+  EXPECT_EQ(b.dominant(), place);
+}
+
 TEST(ErrorBreakdown, AGoalRaisedAtTheClampedEdgeIsAnEdgeError) {
   Eigen::MatrixXd goal = dome(20.0), predicted = goal;
   goal.row(1).array() += 8.0;  // a quarter cell from the border, where the surface is held down
-  const ErrorBreakdown b = error_breakdown(kMesh, goal, predicted);
-  EXPECT_GT(share(b, "clamped_edge"), 0.9);
-  EXPECT_EQ(b.dominant(), "clamped_edge");
+  expect_error_in(goal, predicted, "clamped_edge");
 }
 
 TEST(ErrorBreakdown, APitInACellsMiddleIsAValleyBetweenNodes) {
   Eigen::MatrixXd goal = dome(20.0);
   const Eigen::MatrixXd predicted = goal;
   goal(6, 6) -= 10.0;  // the middle of cell (1, 1), half a cell from every node
-  const ErrorBreakdown b = error_breakdown(kMesh, goal, predicted);
-  EXPECT_GT(share(b, "valley_between_nodes"), 0.9);
-  EXPECT_EQ(b.dominant(), "valley_between_nodes");
+  expect_error_in(goal, predicted, "valley_between_nodes");
 }
 
 TEST(ErrorBreakdown, APitOnANodeIsNotAValleyBetweenNodes) {
@@ -56,9 +59,7 @@ TEST(ErrorBreakdown, ASpikeSmallerThanACellIsSubCellDetail) {
   Eigen::MatrixXd goal = dome(20.0);
   const Eigen::MatrixXd predicted = goal;
   goal(5, 9) += 10.0;  // one point, off its cell's centre: no dome of the cell makes it
-  const ErrorBreakdown b = error_breakdown(kMesh, goal, predicted);
-  EXPECT_GT(share(b, "sub_cell_detail"), 0.9);
-  EXPECT_EQ(b.dominant(), "sub_cell_detail");
+  expect_error_in(goal, predicted, "sub_cell_detail");
 }
 
 TEST(ErrorBreakdown, SharesAddUpAndAPerfectPlanHasNoError) {
