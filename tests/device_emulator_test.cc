@@ -95,6 +95,53 @@ TEST(DeviceEmulator, RefusesWhatTheDeviceCannotDo) {
   EXPECT_EQ(e.simulator().state().pressure_pa, 0.0);
 }
 
+// A settle past the settle timeout (1 ms: any settle from rest to 2 kPa
+// takes longer) is answered "failed" with the state as before, as is one a
+// vent stops; the next vent still ends at rest and answers ok.
+TEST(DeviceEmulator, ASettlePastItsTimeoutOrStoppedFailsAndLeavesTheStateAsItWas) {
+  EmulatorConfig config = testing_support::emulator_config_3x4();
+  config.settle_timeout = 1ms;
+  Emulator e(config);
+  protocol::Request r = request(protocol::Command::kAction, 4);
+  r.action = Action::set_pressure(2000.0);
+  const std::string timed_out = e.handle(r);
+  EXPECT_EQ(timed_out.rfind("err 4 failed set_pressure 2 kPa: the membrane did not settle within 1 ms", 0), 0u)
+      << timed_out;
+  EXPECT_NE(timed_out.find("the state is as before the action"), std::string::npos);
+  EXPECT_EQ(e.simulator().state().pressure_pa, 0.0);
+
+  Emulator stoppable(testing_support::emulator_config_3x4());
+  const std::string stopped = stoppable.handle(r, [] { return true; });
+  EXPECT_EQ(stopped.rfind("err 4 failed set_pressure 2 kPa: stopped by a vent", 0), 0u) << stopped;
+  EXPECT_EQ(stoppable.simulator().state().pressure_pa, 0.0);
+  EXPECT_EQ(stoppable.handle(r), "ok 4");
+  EXPECT_EQ(stoppable.handle(request(protocol::Command::kVent, 5)), "ok 5");
+  EXPECT_EQ(stoppable.simulator().state().pressure_pa, 0.0);
+}
+
+// A vent whose settles are cut short (here by the config's own interrupt,
+// as a timeout would) still ends at rest.
+TEST(DeviceEmulator, AVentEndsAtRestEvenWhenItsSettlesAreCutShort) {
+  auto cut_short = std::make_shared<bool>(false);
+  EmulatorConfig config = testing_support::emulator_config_3x4();
+  config.simulator.interrupted = [cut_short] { return *cut_short; };
+  const Eigen::MatrixXd rest = Emulator(config).exact_frame();
+  Emulator e(config);
+  protocol::Request r = request(protocol::Command::kAction, 1);
+  r.action = Action::set_pressure(2000.0);
+  ASSERT_EQ(e.handle(r), "ok 1");
+  r.action = Action::jam(1, 1);
+  ASSERT_EQ(e.handle(r), "ok 1");
+  r.action = Action::set_pressure(3000.0);
+  ASSERT_EQ(e.handle(r), "ok 1");
+
+  *cut_short = true;
+  EXPECT_EQ(e.handle(request(protocol::Command::kVent, 2)), "ok 2");
+  EXPECT_EQ(e.simulator().state().pressure_pa, 0.0);
+  EXPECT_FALSE(e.simulator().state().jammed(e.simulator().mesh(), 1, 1));
+  EXPECT_LT((e.exact_frame() - rest).cwiseAbs().maxCoeff(), 0.01);
+}
+
 TEST(DeviceEmulatorOptions, DefaultsAreTheSharedSessionsDevice) {
   const auto o = parse_emulator_options({"--listen", "127.0.0.1:0"});
   EXPECT_EQ(o.server.host, "127.0.0.1");
@@ -116,6 +163,8 @@ TEST(DeviceEmulatorOptions, DefaultsAreTheSharedSessionsDevice) {
   EXPECT_EQ(n.config.camera.grid.dy_mm, 4.0);
   EXPECT_EQ(n.config.params.max_pressure_pa, 2000.0);
   EXPECT_EQ(n.config.camera.seed, 9u);
+  EXPECT_EQ(o.config.settle_timeout, 30s);
+  EXPECT_EQ(parse_emulator_options({"--listen", "h:1", "--settle-timeout-s", "5"}).config.settle_timeout, 5s);
 }
 
 TEST(DeviceEmulatorOptions, BadFlagsNameTheFlag) {
@@ -140,6 +189,7 @@ TEST(DeviceEmulatorOptions, BadFlagsNameTheFlag) {
   bad({"--listen", "h:1", "--max-pressure-kpa", "0"}, {"--max-pressure-kpa"});
   bad({"--listen", "h:1", "--params", "/nonexistent/params.json"}, {"--params", "/nonexistent/params.json"});
   bad({"--listen", "h:1", "--drop-after"}, {"--drop-after needs a value"});
+  bad({"--listen", "h:1", "--settle-timeout-s", "0"}, {"--settle-timeout-s", "\"0\""});
   bad({"--listen", "h:1", "--frobnicate"}, {"unknown argument", "--frobnicate"});
 }
 

@@ -41,8 +41,25 @@ SessionGrid default_capture_grid(const ArrayGeometry& geometry) {
   return g;
 }
 
+bool Emulator::SettleLimit::operator()() {
+  if (resetting) return false;
+  if ((outer && outer()) || (stop && stop())) return true;
+  timed_out = std::chrono::steady_clock::now() > deadline;
+  return timed_out;
+}
+
+EmulatorConfig Emulator::with_settle_limit(EmulatorConfig config, const std::shared_ptr<SettleLimit>& limit) {
+  config.camera.validate();
+  if (config.settle_timeout.count() <= 0)
+    throw std::invalid_argument("emulator settle timeout of " + std::to_string(config.settle_timeout.count()) +
+                                " ms: must be positive");
+  limit->outer = std::move(config.simulator.interrupted);
+  config.simulator.interrupted = [limit] { return (*limit)(); };
+  return config;
+}
+
 Emulator::Emulator(EmulatorConfig config)
-    : config_((config.camera.validate(), std::move(config))),
+    : config_(with_settle_limit(std::move(config), limit_)),
       simulator_(config_.geometry, config_.params, config_.simulator),
       camera_random_(config_.camera.seed) {}
 
@@ -56,8 +73,9 @@ protocol::Hello Emulator::hello() const {
   return h;
 }
 
-std::string Emulator::handle(const protocol::Request& r) {
+std::string Emulator::handle(const protocol::Request& r, std::function<bool()> stop) {
   using protocol::Command;
+  limit_->stop = std::move(stop);
   switch (r.command) {
     case Command::kHello: return protocol::format_ok(r.id, protocol::format_hello(hello()));
     case Command::kPing: return protocol::format_ok(r.id);
@@ -65,15 +83,24 @@ std::string Emulator::handle(const protocol::Request& r) {
     case Command::kCapture: return protocol::format_ok(r.id, protocol::format_capture(capture()));
     case Command::kTruth: return protocol::format_ok(r.id, protocol::format_capture(truth()));
     case Command::kVent: return vent(r.id);
-    case Command::kAction: return act(r.id, r.action);
+    case Command::kAction: return act(r.id, r.action, std::chrono::steady_clock::now() + config_.settle_timeout);
     case Command::kFault: break;
   }
   return protocol::format_err(r.id, protocol::ErrorCode::kFailed, "faults are handled by the server, not the device");
 }
 
-std::string Emulator::act(std::uint64_t id, const Action& action) {
+std::string Emulator::act(std::uint64_t id, const Action& action, std::chrono::steady_clock::time_point deadline) {
+  limit_->deadline = deadline;
+  limit_->timed_out = false;
   try {
     simulator_.apply(action);
+  } catch (const SettleInterrupted&) {
+    const std::string why = limit_->timed_out
+                                ? "the membrane did not settle within " +
+                                      std::to_string(config_.settle_timeout.count()) + " ms (the settle timeout)"
+                                : "stopped by a vent";
+    return protocol::format_err(id, protocol::ErrorCode::kFailed,
+                                action.describe() + ": " + why + "; the state is as before the action");
   } catch (const std::invalid_argument& e) {
     const auto code = action.op == Action::Op::kSetPressure ? protocol::ErrorCode::kUnsafe
                                                             : protocol::ErrorCode::kOutOfRange;
@@ -98,11 +125,21 @@ std::string Emulator::vent(std::uint64_t id) {
     for (int c = 0; c < mesh.cols(); ++c)
       if (simulator_.state().jammed(mesh, r, c)) steps.push_back(Action::unjam(r, c));
   steps.push_back(Action::set_pressure(0.0));
-  for (const Action& step : steps) {
-    const std::string reply = act(id, step);
-    if (reply.rfind("err", 0) == 0) return reply;
-  }
+  limit_->stop = {};  // a vent is not itself stopped
+  const auto deadline = std::chrono::steady_clock::now() + config_.settle_timeout;
+  for (const Action& step : steps)
+    if (act(id, step, deadline).rfind("err", 0) == 0) {
+      // The membrane did not settle on the way down: venting ends at rest all the same.
+      reset_to_rest();
+      break;
+    }
   return protocol::format_ok(id);
+}
+
+void Emulator::reset_to_rest() {
+  limit_->resetting = true;
+  simulator_ = Simulator(config_.geometry, config_.params, config_.simulator);
+  limit_->resetting = false;
 }
 
 protocol::StatusPayload Emulator::status() const {

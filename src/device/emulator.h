@@ -6,7 +6,10 @@
 // network side is EmulatorServer.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <random>
 #include <string>
 
@@ -36,6 +39,11 @@ struct EmulatorConfig {
   SurfaceParameters params;  // params.max_pressure_pa is the device's limit
   SimulatorOptions simulator;
   CameraOptions camera;
+  // The longest one action's settle may take before the emulator answers
+  // "failed" with the state as before the action: a device answers within
+  // the link's reply timeout (60 s) even where the model has no equilibrium
+  // it can find. Must be positive.
+  std::chrono::milliseconds settle_timeout{30000};
 };
 
 class Emulator {
@@ -47,7 +55,9 @@ class Emulator {
   protocol::Hello hello() const;
   // The reply line to a hello, status, capture, vent or action request:
   // "ok ID ..." or "err ID CODE message" (out_of_range, unsafe, failed).
-  std::string handle(const protocol::Request& request);
+  // `stop`, polled while settling, ends an action's settle early (answered
+  // "failed", the state as it was): a vent that overtakes it.
+  std::string handle(const protocol::Request& request, std::function<bool()> stop = {});
 
   const Simulator& simulator() const { return simulator_; }
   // The true surface on the camera grid, mm: no measurement effect (a tilted
@@ -58,12 +68,27 @@ class Emulator {
   Eigen::MatrixXd camera_frame() const;
 
  private:
-  std::string act(std::uint64_t id, const Action& action);
+  std::string act(std::uint64_t id, const Action& action, std::chrono::steady_clock::time_point deadline);
   std::string vent(std::uint64_t id);
+  // The rest state at once, as venting ends (nothing jammed or pinned, P = 0).
+  void reset_to_rest();
   protocol::StatusPayload status() const;
   Capture capture();
   Capture truth() const;
 
+  // What the simulator's interrupted callback reads: the current action's
+  // deadline and stop. Shared, so a moved emulator's simulator still sees it.
+  struct SettleLimit {
+    std::function<bool()> outer;  // the config's own SimulatorOptions::interrupted
+    std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+    std::function<bool()> stop;
+    bool timed_out = false;
+    bool resetting = false;  // the rest settle of a reset is never cut short
+    bool operator()();
+  };
+  static EmulatorConfig with_settle_limit(EmulatorConfig config, const std::shared_ptr<SettleLimit>& limit);
+
+  std::shared_ptr<SettleLimit> limit_ = std::make_shared<SettleLimit>();
   EmulatorConfig config_;
   Simulator simulator_;
   std::mt19937_64 camera_random_;

@@ -36,6 +36,9 @@ const char* const kEmulatorUsage =
     "                         captures (hello, ping, status, fault are not\n"
     "                         counted), close the connection on the next one,\n"
     "                         unanswered; once\n"
+    "  --settle-timeout-s S   answer an action \"failed\" (state as before it) when its\n"
+    "                         settle takes longer than S s, 1..3600 (default 30; the\n"
+    "                         server's link waits 60 s for a reply)\n"
     "  --watchdog-ms MS       vent by itself after MS ms without a byte from the\n"
     "                         server while actuated, 100..5000 (default 2000)\n"
     "  --help                 this text\n"
@@ -148,6 +151,8 @@ EmulatorProgramOptions parse_emulator_options(const std::vector<std::string>& ar
     else if (a == "--dropout") dropout = number(a, value());
     else if (a == "--seed") camera.seed = static_cast<std::uint64_t>(whole(a, value(), 0, 1LL << 62));
     else if (a == "--drop-after") out.server.drop_after = whole(a, value(), 0, 1LL << 40);
+    else if (a == "--settle-timeout-s")
+      out.config.settle_timeout = std::chrono::seconds(whole(a, value(), 1, 3600));
     else if (a == "--watchdog-ms") out.server.watchdog = std::chrono::milliseconds(whole(a, value(), 100, 5000));
     else throw std::invalid_argument("unknown argument \"" + a + "\"");
   }

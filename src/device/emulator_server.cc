@@ -273,7 +273,11 @@ struct EmulatorServer::Impl {
 
   void carry_out(const DeviceCommand& command) {
     try {
-      last_reply = emulator.handle(command.request);
+      // A vent that overtakes the command, or the server stopping, ends its settle.
+      last_reply = emulator.handle(command.request, [this, &command] {
+        std::lock_guard lock(mutex);
+        return stopping || command.overtaken;
+      });
     } catch (const std::exception& e) {  // a failure of the device, not of the server
       last_reply = protocol::format_err(command.request.id, protocol::ErrorCode::kFailed, e.what());
     }
