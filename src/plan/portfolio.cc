@@ -83,7 +83,15 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
   std::vector<StrategyOutcome> outcomes(n);
   std::mutex mutex;  // serialises the callbacks and the shared fields below
   std::exception_ptr cancelled;
-  int finished = 0;
+  // Each strategy's own progress, 0..1; the portfolio reports their mean,
+  // which rises as any of them does (a strategy counts 1 once it ends).
+  std::vector<double> fractions(n, 0.0);
+  const auto report = [&](std::size_t k, double fraction, const std::string& what) {  // with `mutex` held
+    fractions[k] = std::max(fractions[k], fraction);
+    double sum = 0.0;
+    for (double f : fractions) sum += f;
+    callbacks.progress(sum / double(n), list[k].first + ": " + what);
+  };
   std::atomic<std::size_t> next{0};
   StrategyBudget budget(options_, Clock::now());
   const auto user_cancelled = [&] { return callbacks.cancelled && callbacks.cancelled(); };
@@ -97,6 +105,11 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
       own.snapshot = [&](const DeviceState& state) {
         const std::lock_guard<std::mutex> lock(mutex);
         callbacks.snapshot(state);
+      };
+    if (callbacks.progress)
+      own.progress = [&, k](double fraction, const std::string& what) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        report(k, std::clamp(fraction, 0.0, 1.0), what);
       };
     StrategyOutcome& out = outcomes[k];
     const double started_s = budget.elapsed_s();
@@ -115,8 +128,7 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
     out.seconds = budget.elapsed_s() - started_s;
     if (k == 0 && out.result) budget.algorithm2_took(out.seconds);
     const std::lock_guard<std::mutex> lock(mutex);
-    ++finished;
-    if (callbacks.progress) callbacks.progress(double(finished) / double(n), list[k].first + " finished");
+    if (callbacks.progress) report(k, 1.0, out.result ? "finished" : "stopped");
   };
   const auto worker = [&] {
     for (std::size_t k; (k = next.fetch_add(1)) < n;) run(k);
