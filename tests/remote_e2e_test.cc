@@ -242,7 +242,9 @@ TEST(RemoteEndToEnd, LinkDropInterruptsVentsAndPausesUntilResumed) {
   // actions, and its third action is never answered.
   Rig rig({}, {"--drop-after", "6"});
   rig.ready();
-  rig.stall_device(1500);  // both jobs are queued before anything runs
+  // Both jobs are queued before anything runs: the stall outlasts two CLI
+  // submits even on a loaded machine (under 1.5 s, b sometimes came after a's drop).
+  rig.stall_device(6000);
   const std::int64_t a = rig.submit(rig.plan_file("a", json::array({{{"op", "set_pressure"}, {"kpa", 0.5}},
                                                                      {{"op", "jam"}, {"cell", {0, 0}}},
                                                                      {{"op", "jam"}, {"cell", {1, 2}}},
