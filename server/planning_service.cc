@@ -137,9 +137,10 @@ grpc::Status PlanningServiceImpl::Preview(grpc::ServerContext* context, const v1
   RequestContext rc(context, "Preview");
   return rc.finish([&] {
     rc.authorize(auth_, Role::kPreview, "Preview");
-    // Quick: a coarse mesh unless the caller chose one.
+    // Quick: a coarse mesh and the fastest planner unless the caller chose them.
     v1::PreviewRequest coarse = *request;
     if (coarse.array().segments() == 0) coarse.mutable_array()->set_segments(kPreviewSegments);
+    if (coarse.planner().empty()) coarse.set_planner(kPreviewPlanner);
     v1::PlanResult result;
     const grpc::Status status = plan_or_cached(context, coarse, false, nullptr, &result);
     if (!status.ok()) throw ServiceError(status.error_code(), status.error_message());

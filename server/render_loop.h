@@ -13,6 +13,7 @@
 #include <string>
 
 #include "auth.h"
+#include "plan/default_planner.h"
 #include "device_queue.h"
 #include "hapticjam/v1/render_service.pb.h"
 #include "proto_convert.h"
@@ -22,7 +23,7 @@ namespace hj::server {
 struct RenderSetup {
   ArrayConfig array;        // the planner's array and model
   Eigen::MatrixXd goal_mm;  // the goal at the mesh points
-  std::string planner = "algorithm2";
+  std::string planner = kRenderPlanner;
   int iterations = 5;
   hapticjam::v1::RenderCorrection correction = hapticjam::v1::RENDER_CORRECTION_TARGETS;
   // Above 1: a device seldom moves by all of a target's change (a plan pins

@@ -9,6 +9,7 @@
 
 #include "metrics/correlation.h"
 #include "metrics/laplace_predictor.h"
+#include "plan/default_planner.h"
 #include "plan/planner.h"
 #include "server_fixture.h"
 #include "shapes/goal_importer.h"
@@ -58,11 +59,14 @@ void wait_until_running(grpc::ClientReader<v1::PlanEvent>& reader) {
   ASSERT_TRUE(event.has_progress());
 }
 
+// Named: Algorithm 2 is deterministic, and each snapshot is its plan's next
+// step (the portfolio streams Algorithm 2's, then its chosen final state).
 TEST(ServerPlanning, StreamsProgressSnapshotsAndTheLibrarysResult) {
   ScratchDir dir;
   TestServer s(options(1, 4, dir.path / "q.db"), false);
   v1::PlanRequest request = plan_request(3, 4);
   request.mutable_array()->set_segments(2);
+  request.set_planner("algorithm2");
   auto context = call();
   auto reader = s.planning->Plan(context.get(), request);
   int progress = 0, snapshots = 0, results = 0;
@@ -106,6 +110,47 @@ TEST(ServerPlanning, StreamsProgressSnapshotsAndTheLibrarysResult) {
   EXPECT_EQ(result.predicted().heights_mm(5 * 9 + 4), predicted(5, 4));
   EXPECT_EQ(result.predicted().pressure_pa(), plan.final_state.pressure_pa);
   EXPECT_EQ(nlohmann::json::parse(result.steps_json()).size(), plan.steps.size());
+}
+
+// A Plan naming no planner gets the default (the portfolio, with streamed
+// progress that rises); a Preview, the quick Algorithm 2.
+TEST(ServerPlanning, ARequestNamingNoPlannerGetsTheDefaultAndAPreviewTheQuickOne) {
+  ScratchDir dir;
+  TestServer s(options(1, 4, dir.path / "q.db"), false);
+  v1::PlanRequest request = plan_request(3, 4);
+  request.mutable_array()->set_segments(2);
+  auto context = call();
+  auto reader = s.planning->Plan(context.get(), request);
+  int progress = 0;
+  double last_fraction = -1.0;
+  v1::PlanResult result;
+  for (v1::PlanEvent event; reader->Read(&event);) {
+    if (event.has_progress()) {
+      EXPECT_GE(event.progress().fraction(), last_fraction);
+      EXPECT_LE(event.progress().fraction(), 1.0);
+      last_fraction = event.progress().fraction();
+      ++progress;
+    } else if (event.has_result()) {
+      result = event.result();
+    }
+  }
+  ASSERT_TRUE(reader->Finish().ok());
+  EXPECT_EQ(result.plan().planner(), kDefaultPlanner);
+  EXPECT_GT(progress, 4);  // the strategies' own progress, not only their ends
+
+  v1::PreviewRequest preview = preview_request(3, 4);
+  preview.mutable_array()->set_segments(2);
+  v1::PreviewResponse quick;
+  ASSERT_TRUE(s.planning->Preview(call().get(), preview, &quick).ok());
+  request.set_planner(kPreviewPlanner);
+  auto named_context = call();
+  auto named = s.planning->Plan(named_context.get(), request);
+  v1::PlanResult algorithm2;
+  for (v1::PlanEvent event; named->Read(&event);)
+    if (event.has_result()) algorithm2 = event.result();
+  ASSERT_TRUE(named->Finish().ok());
+  EXPECT_EQ(quick.step_count(), algorithm2.plan().steps_size());
+  EXPECT_EQ(quick.correlation(), algorithm2.correlation());
 }
 
 TEST(ServerPlanning, ARepeatedRequestComesFromTheCache) {

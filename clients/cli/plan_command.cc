@@ -45,7 +45,7 @@ constexpr const char* kPlanUsage =
     "DIR/predicted_x.csv and predicted_y.csv (in-plane positions, mm) and DIR/compare.png.\n"
     "  --rows R, --cols C    array size in cells (38 mm cells)\n"
     "  --segments P          segments per cell edge (default 4)\n"
-    "  --planner NAME        default algorithm2\n"
+    "  --planner NAME        default portfolio (Algorithm 2 and three variants, the best kept)\n"
     "  --max-height-mm H     goal height range on the display (default: 10 mm per cell\n"
     "                        of the array's shorter side, e.g. 30 mm at 3 x 4, 90 mm at 9 x 12)\n"
     "  --heights H           scaled (default: stretched to --max-height-mm) or absolute:\n"
@@ -66,7 +66,7 @@ constexpr const char* kPlanUsage =
     "                        0.8..1 of its side so its valleys fall on nodes; plans the\n"
     "                        unaligned goal and the best few candidates and keeps the best\n"
     "                        (plan.json \"align\": transform and gain; docs/planners.md)\n";
-static_assert(std::string_view(kDefaultPlanner) == "algorithm2", "kPlanUsage names the default planner");
+static_assert(std::string_view(kDefaultPlanner) == "portfolio", "kPlanUsage names the default planner");
 
 struct PlanArgs {
   std::string goal, out, planner = kDefaultPlanner, region, region_lonlat;

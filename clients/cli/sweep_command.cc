@@ -36,7 +36,7 @@ constexpr const char* kSweepUsage =
     "(at the alpha_L whose fit is best).\n"
     "  --sizes S           \"paper\" (default: the 16 sizes of Table 1, 1x2 .. 9x12), \"quick\"\n"
     "                      (2x2,3x4,4x6,6x8,9x12) or a list such as 2x2,3x4\n"
-    "  --planner NAME      default algorithm2\n"
+    "  --planner NAME      default portfolio (Algorithm 2 and three variants, the best kept)\n"
     "  --jobs N            threads (default: one per core)\n"
     "  --budget-s S        per plan; a plan past it is stopped at its next action and\n"
     "                      recorded as over-budget (default 120)\n"
@@ -53,7 +53,7 @@ constexpr const char* kSweepUsage =
     "                      align_gain, unaligned_seconds and align_planned\n"
     "  --align-pick P      cost (default: the windows of lowest valley cost) or random\n"
     "                      (a control: as many windows at random, seeded); implies --align\n";
-static_assert(std::string_view(kDefaultPlanner) == "algorithm2", "kSweepUsage names the default planner");
+static_assert(std::string_view(kDefaultPlanner) == "portfolio", "kSweepUsage names the default planner");
 
 struct SweepArgs {
   std::vector<std::string> goals;
