@@ -54,7 +54,9 @@ bool DivergenceSearch::sym_positive_definite() {
   Factors& f = *factors_;
   if (!f.sym_positive_definite) {
     const Eigen::SparseMatrix<double> sym = 0.5 * (stiffness_ + Eigen::SparseMatrix<double>(stiffness_.transpose()));
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(sym);
+    // Natural order: K is banded in the mesh's order already, and in the
+    // server's build Eigen's AMD ordering read past its own buffer (ASan).
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(sym);
     f.sym_positive_definite = false;
     if (ldlt.info() == Eigen::Success) {
       const Eigen::VectorXd d = ldlt.vectorD();
