@@ -5,6 +5,7 @@
 # LEAKS=1 also reports leaks (off by default: gRPC, GDAL and OpenCV keep
 # allocations alive until exit). HJ_TEST_TIMEOUT (default 3600 s) is the
 # per-test limit: the instrumented calibration tests run several times slower.
+# HJ_TEST_TIME_SCALE (default 10) multiplies the tests' own hang bounds.
 # Usage: scripts/sanitize.sh [BUILD_DIR] [extra ctest arguments...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,5 +17,6 @@ cmake -S . -B "$build" -G Ninja -DHJ_SANITIZE=ON -DHJ_BUILD_BENCHMARKS=OFF -DCMA
   -DHJ_TEST_TIMEOUT="${HJ_TEST_TIMEOUT:-3600}"
 cmake --build "$build" -j2
 export ASAN_OPTIONS="detect_leaks=${LEAKS:-0}:abort_on_error=1"
+export HJ_TEST_TIME_SCALE="${HJ_TEST_TIME_SCALE:-10}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 ctest --test-dir "$build" -j2 --output-on-failure "$@"

@@ -8,13 +8,16 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -151,6 +154,8 @@ inline CliResult run_cli(const std::vector<std::string>& args, const std::filesy
 }
 
 // A raw protocol connection to the emulator (src/device/PROTOCOL.md), for faults.
+// While it waits for a reply it sends the link's heartbeat (a `ping` every
+// 200 ms), so a long settle is not taken for silence by the watchdog.
 class EmulatorLine {
  public:
   explicit EmulatorLine(int port) {
@@ -161,22 +166,27 @@ class EmulatorLine {
     addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     if (connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0)
       throw std::runtime_error("cannot connect to the emulator");
-    timeval tv{30, 0};
-    setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
   }
   ~EmulatorLine() { close(fd_); }
   // Sends "ID COMMAND" and returns the reply line to that id.
   std::string request(const std::string& command) {
-    const std::string id = std::to_string(++id_);
-    const std::string line = id + " " + command + "\n";
-    if (::send(fd_, line.data(), line.size(), MSG_NOSIGNAL) != ssize_t(line.size()))
-      throw std::runtime_error("emulator write failed");
+    const std::string id = send_line(command);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(10);
     while (true) {
       const auto nl = buffer_.find('\n');
       if (nl != std::string::npos) {
         std::string reply = buffer_.substr(0, nl);
         buffer_.erase(0, nl + 1);
-        if (reply.find(" " + id) != std::string::npos) return reply;
+        std::istringstream words(reply);
+        std::string status, reply_id;
+        words >> status >> reply_id;
+        if (reply_id == id) return reply;
+        continue;
+      }
+      if (std::chrono::steady_clock::now() > give_up) throw std::runtime_error("no reply to " + command);
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 200) == 0) {
+        send_line("ping");
         continue;
       }
       char chunk[4096];
@@ -187,16 +197,31 @@ class EmulatorLine {
   }
 
  private:
+  std::string send_line(const std::string& command) {
+    const std::string id = std::to_string(++id_);
+    const std::string line = id + " " + command + "\n";
+    if (::send(fd_, line.data(), line.size(), MSG_NOSIGNAL) != ssize_t(line.size()))
+      throw std::runtime_error("emulator write failed");
+    return id;
+  }
+
   int fd_ = -1;
   int id_ = 0;
   std::string buffer_;
 };
 
-// Polls `done` every 20 ms for up to `seconds` (a bound against hanging, not
-// a timing assertion); true once it holds.
+// Hang bounds grow by HJ_TEST_TIME_SCALE (default 1): the sanitizer build
+// (scripts/sanitize.sh) runs several times slower.
+inline double time_scale() {
+  const char* scale = std::getenv("HJ_TEST_TIME_SCALE");
+  return scale ? std::max(1.0, std::atof(scale)) : 1.0;
+}
+
+// Polls `done` every 20 ms for up to `seconds` x time_scale() (a bound
+// against hanging, not a timing assertion); true once it holds.
 template <typename F>
 bool wait_until(F done, double seconds = 30.0) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds * time_scale());
   while (std::chrono::steady_clock::now() < end) {
     if (done()) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

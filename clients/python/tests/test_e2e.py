@@ -27,6 +27,9 @@ SHARED = os.environ["HJ_SHARED_DIR"]
 DEM = os.path.join(SHARED, "data", "dem", "volcano_maunga_whau.csv")
 MESH = os.path.join(SHARED, "data", "mesh", "openscad_letterblock.stl")
 DEMO_BASELINE = os.path.join(SHARED, "data", "sessions", "demo-baseline")  # README: M 0.52 kg, k 58 N/m
+# Hang bounds (not timing assertions) grow by HJ_TEST_TIME_SCALE: the
+# sanitizer build (scripts/sanitize.sh) runs several times slower.
+TIME_SCALE = float(os.environ.get("HJ_TEST_TIME_SCALE", "1"))
 EXAMPLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "examples")
 
 
@@ -35,7 +38,7 @@ def start(argv, folder, name, pattern):
     out_path, err_path = os.path.join(folder, name + ".out"), os.path.join(folder, name + ".err")
     with open(out_path, "w") as out, open(err_path, "w") as err:
         process = subprocess.Popen(argv, stdout=out, stderr=err)
-    deadline = time.monotonic() + 30
+    deadline = time.monotonic() + 30 * TIME_SCALE
     while time.monotonic() < deadline:
         with open(out_path) as out:
             m = re.search(pattern, out.read())
@@ -51,7 +54,7 @@ def start(argv, folder, name, pattern):
 
 def wait_until(predicate, seconds=30):
     """Polls (a bound against hanging, not a timing assertion)."""
-    deadline = time.monotonic() + seconds
+    deadline = time.monotonic() + seconds * TIME_SCALE
     while time.monotonic() < deadline:
         if predicate():
             return True
@@ -79,7 +82,7 @@ class Rig:
             p.wait()
 
     def stall_device(self, ms):
-        with socket.create_connection(("127.0.0.1", self.emulator_port), timeout=30) as s:
+        with socket.create_connection(("127.0.0.1", self.emulator_port), timeout=30 * TIME_SCALE) as s:
             s.sendall(f"1 fault stall {ms}\n".encode())
             self.assert_reply(s.recv(256), b"ok 1")
 
@@ -96,7 +99,7 @@ class Rig:
 
     def cli(self, *args, token=None):
         argv = [CLI, "remote", *args, "--server", self.address] + (["--token", token] if token else [])
-        return subprocess.run(argv, capture_output=True, text=True, timeout=120)
+        return subprocess.run(argv, capture_output=True, text=True, timeout=120 * TIME_SCALE)
 
 
 def read_varint(data, at):
@@ -140,7 +143,7 @@ def reflected_services(address):
     with grpc.insecure_channel(address) as channel:
         info = channel.stream_stream("/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo")
         request = bytes([(7 << 3) | 2, 1]) + b"*"
-        responses = list(info(iter([request]), timeout=30))
+        responses = list(info(iter([request]), timeout=30 * TIME_SCALE))
     names = []
     for response in responses:
         for listing in length_delimited_fields(response, 6):
@@ -150,7 +153,7 @@ def reflected_services(address):
 
 
 def queue_ids(client):
-    return [j.id for j in next(client.watch(timeout=30)).jobs]
+    return [j.id for j in next(client.watch(timeout=30 * TIME_SCALE)).jobs]
 
 
 class PlanningTest(unittest.TestCase):
@@ -176,7 +179,7 @@ class PlanningTest(unittest.TestCase):
             info = channel.stream_stream("/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo")
             symbol = b"hapticjam.v1.PlanningService"
             request = bytes([(4 << 3) | 2, len(symbol)]) + symbol
-            responses = list(info(iter([request]), timeout=30))
+            responses = list(info(iter([request]), timeout=30 * TIME_SCALE))
         files = [f for r in responses for d in length_delimited_fields(r, 4) for f in length_delimited_fields(d, 1)]
         file_names = [n.decode() for f in files for n in length_delimited_fields(f, 1)]
         self.assertIn("hapticjam/v1/planning_service.proto", file_names)
@@ -191,7 +194,7 @@ class PlanningTest(unittest.TestCase):
             elif kind == "snapshot":
                 snapshots.append(event.snapshot)
 
-        result, count = self.client.plan(file_goal(DEM), 3, 4, on_event=seen, timeout=120)
+        result, count = self.client.plan(file_goal(DEM), 3, 4, on_event=seen, timeout=120 * TIME_SCALE)
         self.assertEqual(count, len(snapshots))
         self.assertGreater(count, 1)
         self.assertEqual(fractions, sorted(fractions))
@@ -217,7 +220,7 @@ class PlanningTest(unittest.TestCase):
             region = (0.0, 0.0, 1.0 - 0.01 * k, 1.0)  # distinct, so neither is a cache hit
             request = planning_service_pb2.PlanRequest(array=array_pb2.ArraySpec(rows=6, cols=8, segments=6),
                                                        goal=file_goal(DEM, region=region))
-            return self.client.planning.Plan(request, timeout=120)
+            return self.client.planning.Plan(request, timeout=120 * TIME_SCALE)
 
         running = long_plan(1)
         next(running)  # it holds the one worker
@@ -253,7 +256,7 @@ class PlanningTest(unittest.TestCase):
 
     def test_map_zoom_example_repeats_come_from_the_cache(self):
         out = subprocess.run([sys.executable, os.path.join(EXAMPLES, "map_zoom.py"), "--server", self.rig.address,
-                              "--map", "volcano"], capture_output=True, text=True, timeout=300)
+                              "--map", "volcano"], capture_output=True, text=True, timeout=300 * TIME_SCALE)
         self.assertEqual(out.returncode, 0, out.stderr)
         rows = [line.split() for line in out.stdout.splitlines()[1:]]
         self.assertEqual(len(rows), 6)
@@ -265,7 +268,7 @@ class PlanningTest(unittest.TestCase):
     def test_cad_preview_example_writes_a_png_of_the_surface(self):
         png = os.path.join(self.rig.folder, "block.png")
         out = subprocess.run([sys.executable, os.path.join(EXAMPLES, "cad_preview.py"), "--server", self.rig.address,
-                              MESH, "--out", png], capture_output=True, text=True, timeout=300)
+                              MESH, "--out", png], capture_output=True, text=True, timeout=300 * TIME_SCALE)
         self.assertEqual(out.returncode, 0, out.stderr)
         with open(png, "rb") as f:
             data = f.read()
@@ -276,7 +279,7 @@ class PlanningTest(unittest.TestCase):
 
     def _preview_ok(self, region):
         try:
-            self.client.preview(file_goal(DEM, region=region), 3, 4, timeout=60)
+            self.client.preview(file_goal(DEM, region=region), 3, 4, timeout=60 * TIME_SCALE)
             return True
         except ClientError as e:
             if e.code != grpc.StatusCode.RESOURCE_EXHAUSTED:
@@ -309,7 +312,7 @@ class DeviceTest(unittest.TestCase):
         b1 = int(json.loads(bob_says.stdout)["id"])
         a2 = self.alice.submit(one, "alice 2")
         # Alice (Python) sees Bob's job (C++ CLI) ahead of her second; Bob saw hers ahead of his.
-        jobs = {j.id: j for j in next(self.alice.watch(timeout=30)).jobs}
+        jobs = {j.id: j for j in next(self.alice.watch(timeout=30 * TIME_SCALE)).jobs}
         self.assertLess(jobs[b1].position, jobs[a2.id].position)
         self.assertEqual(jobs[b1].owner, "bob")
         self.assertLess(jobs[a1.id].position, json.loads(bob_says.stdout)["position"])
@@ -349,7 +352,8 @@ class CalibrationTest(unittest.TestCase):
             os.symlink(os.path.join(DEMO_BASELINE, name), os.path.join(cls.baseline, name))
         cls.tilted = os.path.join(cls.rig.folder, "tilted")
         made = subprocess.run([CLI, "synth", cls.baseline, "--out", cls.tilted, "--set", "sensor_tilt.offset_mm=1.5",
-                               "--set", "sensor_tilt.tilt_x_mrad=15"], capture_output=True, text=True, timeout=120)
+                               "--set", "sensor_tilt.tilt_x_mrad=15"],
+                              capture_output=True, text=True, timeout=120 * TIME_SCALE)
         assert made.returncode == 0, made.stderr
 
     @classmethod
@@ -360,7 +364,7 @@ class CalibrationTest(unittest.TestCase):
     def test_fit_recovers_the_stated_mass_and_stiffness_and_reports_progress(self):
         events = []
         fit = self.client.fit(dataset_upload(self.baseline), holdout=["mixed-1"], on_progress=events.append,
-                               timeout=240)
+                               timeout=240 * TIME_SCALE)
         values = {p.name: p for p in fit.parameters}
         self.assertAlmostEqual(values["mass_kg"].value / 0.52, 1.0, delta=0.03)
         self.assertAlmostEqual(values["spring_k"].value / 58.0, 1.0, delta=0.03)
@@ -371,7 +375,7 @@ class CalibrationTest(unittest.TestCase):
         for e in events:
             self.assertLessEqual(e.done, e.total)
         # The returned params.json drives a compare at the noise floor.
-        compared = self.client.compare(dataset_upload(self.baseline), params_json=fit.params_json, timeout=120)
+        compared = self.client.compare(dataset_upload(self.baseline), params_json=fit.params_json, timeout=120 * TIME_SCALE)
         self.assertLess(compared.rmse_mm, 1.1 * compared.noise_floor_mm)
         summary = json.loads(compared.summary_json)
         self.assertEqual({s["name"] for s in summary["sessions"]}, {"unjammed-sweep", "mixed-1"})
@@ -383,7 +387,7 @@ class CalibrationTest(unittest.TestCase):
         self.assertEqual(compared.report_html.count("data:image/png;base64,"), len(images))
 
     def test_diagnose_finds_the_camera_tilt_that_synth_added(self):
-        result = self.client.diagnose(dataset_upload(self.tilted), effects=["sensor_tilt", "bending"], timeout=240)
+        result = self.client.diagnose(dataset_upload(self.tilted), effects=["sensor_tilt", "bending"], timeout=240 * TIME_SCALE)
         self.assertEqual(list(result.verdict), ["sensor_tilt"])
         self.assertGreater(result.baseline_rmse_mm, 1.2 * result.noise_floor_mm)
         self.assertLess(result.final_rmse_mm, 1.1 * result.noise_floor_mm)
@@ -399,7 +403,7 @@ class CalibrationTest(unittest.TestCase):
         dataset = dataset_upload(self.baseline)
         dataset.sessions[0].session_json = "{"
         with self.assertRaises(ClientError) as raised:
-            self.client.diagnose(dataset, timeout=60)
+            self.client.diagnose(dataset, timeout=60 * TIME_SCALE)
         self.assertEqual(raised.exception.code, grpc.StatusCode.INVALID_ARGUMENT)
         self.assertIn(dataset.sessions[0].name, raised.exception.details)
 
