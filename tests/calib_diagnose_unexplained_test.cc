@@ -78,5 +78,28 @@ TEST(CalibDiagnoseUnexplained, AnEffectNoCandidateHasIsNotExplainedAway) {
   EXPECT_EQ(verdict.find("No effect is needed"), std::string::npos) << verdict;
 }
 
+// Where a candidate's local refit leaves the data unexplained, its new
+// parameter is searched over its whole range (calib/multi_start.h) before
+// it is judged; the search does not explain the bump away either.
+TEST(CalibDiagnoseUnexplained, AnUnexplainedRefitIsSearchedOverItsParametersRange) {
+  testing_support::ScratchDir scratch("bump-range");
+  testing_support::write_tiny_sessions(scratch.path / "sessions");
+  synthesize_dataset(scratch.path / "sessions", scratch.path / "data", testing_support::true_tiny_baseline(),
+                     SynthOptions{});
+  add_camera_bump(scratch.path / "data");
+  const Dataset d = read_dataset(scratch.path / "data");
+  DiagnoseOptions o;
+  o.candidates = {"stiffening"};
+  o.max_effects = 1;
+  o.screening = false;  // refit it whatever the screening predicts
+  o.fit.least_squares.max_iterations = 10;
+  const Diagnosis result = diagnose(d, ModelParams{}, o);
+  ASSERT_EQ(result.ranking.size(), 1u);
+  const CandidateFit& stiffening = result.ranking.front();
+  EXPECT_EQ(stiffening.multi_start_parameter, "stiffening.beta");
+  EXPECT_EQ(stiffening.starts_tried.size(), 4u);
+  EXPECT_FALSE(result.goodness.explained) << fit_quality_sentence(result);
+}
+
 }  // namespace
 }  // namespace hj

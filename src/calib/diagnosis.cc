@@ -8,9 +8,10 @@
 #include "calib/candidate_screening.h"
 #include "calib/cell_search.h"
 #include "calib/final_model.h"
-#include "calib/range_start.h"
 #include "calib/gain_by_capture.h"
+#include "calib/goodness_of_fit.h"
 #include "calib/like_with_like.h"
+#include "calib/range_start.h"
 
 namespace hj {
 
@@ -322,6 +323,25 @@ void scan_and_screen(const Selection& s, const std::vector<std::string>& remaini
   }
 }
 
+// A local refit that leaves the data unexplained may have stopped in the
+// basin the current model's distorted optimum put it in (a strong effect
+// the baseline absorbed): where a short fit from the new parameter's range
+// already beats it, the candidate is refitted in full from there and the
+// better fit kept. A refit that explains the data costs nothing more.
+void refit_over_range_if_unexplained(const Selection& s, const std::vector<FitParameter>& parameters,
+                                     const LeastSquaresProgress& progress, CandidateFit& c) {
+  if (goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) return;
+  const std::optional<ModelParams> start = better_start_than_local(s.dataset, c.fit, s.options, s.progress, c);
+  if (!start) return;
+  CandidateFit from_range = c;
+  from_range.scanned_start = *start;
+  LeastSquaresResult again = fit_candidate(s.dataset, s.current.params, from_range, parameters, s.options, progress);
+  if (again.sum_sq_mm2 < c.fit.sum_sq_mm2) {
+    c.fit = std::move(again);
+    c.scanned_start = *start;
+  }
+}
+
 // Refits one candidate from the current optimum, cross-validates it and
 // judges it; false (and said so in out.skipped) if the model cannot replay it.
 bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
@@ -333,11 +353,12 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
   // Warm start: the current model's optimum, the new effect where the scan
   // found it best, or where the best short fit over its range ended.
   try {
-    start_from_best_of_range(s.dataset, s.current.params, s.options, s.progress, c);
-    c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options,
-                          [&](int iteration, int max_iterations, double rmse) {
-                            if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
-                          });
+    const LeastSquaresProgress fit_progress = [&](int iteration, int max_iterations, double rmse) {
+      if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
+    };
+    if (s.options.multi_start_before_refit) start_from_best_of_range(s.dataset, s.current.params, s.options, progress, c);
+    c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options, fit_progress);
+    if (!s.options.multi_start_before_refit) refit_over_range_if_unexplained(s, parameters, fit_progress, c);
     if (progress) progress("cross-validation", 0, 1, effect);
     c.heldout_rmse_mm = cross_validate(s.dataset, parameters, c.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
     c.delta_bic = bic(c.fit) - bic(s.current);

@@ -58,14 +58,15 @@ struct DiagnoseOptions {
   // that passes the screening.
   double refit_cutoff = 2.0;
   EffectScanOptions scan_options;
-  // A refitted candidate with one parameter starts from the best of short
-  // joint fits from values spanning that parameter's range and from the
-  // scan's start (multi_start.h). starts = 0: from the scan's start only.
-  // Off by default: on demo-bending's cheap sessions its short fits took
-  // Diagnose.FindsTheBendingStiffnessInDemoBending past 10 minutes on the
-  // loaded 2-core machine; it must first be made to run only where the
-  // local refit leaves the model unexplained.
-  MultiStartOptions multi_start{0, 2};
+  // A refitted candidate with one parameter whose local refit leaves the
+  // data unexplained (goodness below) is looked at over that parameter's
+  // whole range: short joint fits from values spanning it (multi_start.h),
+  // and if one already beats the local fit, a full refit from there, the
+  // better kept. starts = 0: the local refit only.
+  MultiStartOptions multi_start{4, 2};
+  // The short fits before every such refit instead, from the range and the
+  // scan's start (range_start.h), explained or not.
+  bool multi_start_before_refit = false;
   // Whether the final model explains the data (goodness_of_fit.h).
   GoodnessOfFitOptions goodness;
   // A candidate whose predicted delta BIC passes but whose predicted

@@ -36,4 +36,18 @@ void start_from_best_of_range(const Dataset& dataset, const ModelParams& current
   if (progress) progress("multi-start " + c.added, 1, 1, "");
 }
 
+std::optional<ModelParams> better_start_than_local(const Dataset& dataset, const LeastSquaresResult& local,
+                                                   const DiagnoseOptions& options, const DiagnoseProgress& progress,
+                                                   CandidateFit& c) {
+  if (options.multi_start.starts < 1 || !wants_multi_start(c.added)) return std::nullopt;
+  if (progress) progress("multi-start " + c.added, 0, 1, "");
+  const MultiStart range = multi_start(dataset, local.params, fit_parameters(c.effects), c.added,
+                                       options.fit.least_squares, options.multi_start);
+  c.multi_start_parameter = range.parameter;
+  c.starts_tried = range.tried;
+  if (progress) progress("multi-start " + c.added, 1, 1, "");
+  if (range.found && range.best_sum_sq_mm2 < local.sum_sq_mm2) return range.best;
+  return std::nullopt;
+}
+
 }  // namespace hj
