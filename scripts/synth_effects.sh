@@ -95,6 +95,14 @@ cases=(
   "stiffening_large+sensor_tilt|stiffening,sensor_tilt|stiffening.beta=600,sensor_tilt.tilt_x_mrad=15,sensor_tilt.tilt_y_mrad=-10,sensor_tilt.offset_mm=1.5"
   "cell_defect+pressure_offset|cell_defect,pressure_offset|cell_defect.factor=0.5,cell_defect.row=1,cell_defect.col=2,pressure_offset.gain=1.05,pressure_offset.offset_pa=40"
   "stiffening+cell_stiffness|stiffening,cell_stiffness|stiffening.beta=0.5,cell_stiffness.grad_x=0.15,cell_stiffness.bulge=-0.15"
+  # Effects written only for the test (tests/tools/offform_effects.cc, made
+  # by build/synth_offform): the form differs from the nearest candidate's,
+  # which diagnose should choose; the camera bump is like no candidate, so
+  # the data should stay unexplained with the residual over cell [1, 2].
+  "offform_power_stiffening|test_power_stiffening|test_power_stiffening.beta=5000"
+  "offform_interior_contraction|test_interior_contraction|test_interior_contraction.contraction=0.1"
+  "offform_soft_interior|test_soft_interior|test_soft_interior.factor=0.3,test_soft_interior.row=1,test_soft_interior.col=2"
+  "unknown_camera_bump|test_camera_bump|test_camera_bump.height_mm=5,test_camera_bump.row=1,test_camera_bump.col=2"
 )
 
 # The true baseline: demo-baseline's (its README), not the paper's defaults,
@@ -139,8 +147,25 @@ for entry in "${ordered[@]}"; do
     IFS=, read -ra items <<<"$sets"
     for item in "${items[@]}"; do model+=(--set "$item"); done
   fi
+  synth=("$hj" synth "$base" --out "$dir/data" "${model[@]}")
+  if [[ "$effects" == test_* ]]; then
+    # The test-only effects: their params file written here, as --set would.
+    python3 - "$truth_base" "$effects" "$sets" >"$dir/params.json" <<'PY'
+import json, sys
+doc = json.load(open(sys.argv[1]))
+effects = doc.setdefault("effects", {})
+for name in sys.argv[2].split(","):
+    effects.setdefault(name, {})
+for item in filter(None, sys.argv[3].split(",")):
+    key, value = item.split("=")
+    effect, parameter = key.split(".")
+    effects[effect][parameter] = float(value)
+print(json.dumps(doc))
+PY
+    synth=("$build/synth_offform" "$base" --out "$dir/data" --params "$dir/params.json")
+  fi
   if [[ ! -f "$dir/data/truth.json" ]]; then
-    if ! nice -n 5 "$hj" synth "$base" --out "$dir/data" "${model[@]}" --threads "$threads" >"$dir/synth.log" 2>&1; then
+    if ! nice -n 5 "${synth[@]}" --threads "$threads" >"$dir/synth.log" 2>&1; then
       echo "synth $name failed: $(tail -1 "$dir/synth.log")" >&2
       rm -rf "$dir/data"
       continue

@@ -29,6 +29,20 @@ def g(v):
     return "%.4g" % v
 
 
+# The effects written only for the test (tests/tools/offform_effects.cc) and
+# the candidate diagnose should choose for each; none for the camera bump,
+# which no candidate has: its data should stay unexplained.
+NEAREST = {"test_power_stiffening": ["stiffening"], "test_interior_contraction": ["jam_contraction"],
+           "test_soft_interior": ["cell_defect"], "test_camera_bump": []}
+
+
+def expected_verdict(truth):
+    out = set()
+    for effect in truth.get("effects", {}):
+        out.update(NEAREST.get(effect, [effect]))
+    return sorted(out)
+
+
 def true_values(truth):
     out = []
     for effect, params in sorted(truth.get("effects", {}).items()):
@@ -67,7 +81,11 @@ def row(work, case):
     if diag is None:
         return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal), "not run", "", "", "", "", "", "", ""]
     verdict = ", ".join(diag["verdict"]) or "none"
-    correct = sorted(diag["verdict"]) == sorted(truth.get("effects", {}))
+    expected = expected_verdict(truth)
+    correct = sorted(diag["verdict"]) == expected
+    unknown = [e for e in truth.get("effects", {}) if NEAREST.get(e) == []]
+    if unknown:
+        correct = correct and diag.get("explained") is False
     ranking = []
     for c in diag["ranking"][:3]:
         mark = "*" if c["significant"] else ("s" if c.get("screened_out") else "")
@@ -79,12 +97,19 @@ def row(work, case):
     for e, n, v in truths:
         f, note = fitted_value(diag, e, n)
         fitted.append("%s.%s = %s%s" % (e, n, g(f), note) if f is not None else "%s.%s: -" % (e, n))
+    for e in truth.get("effects", {}):
+        for nearest in NEAREST.get(e, []):
+            for n, f in sorted(diag.get("final_params", {}).get("effects", {}).get(nearest, {}).items()):
+                fitted.append("nearest %s.%s = %s" % (nearest, n, g(f)))
     surface = diag["final_params"]["surface"]
     surface_text = "m %.3f, k %.1f, kj %.2f" % (surface["mass_kg"], surface["spring_k"], surface["kappa_jam"])
     ladder = diag["ladder"]
     rmse_text = "%.3f -> %.3f (floor %.3f)" % (ladder[0]["rmse_mm"], ladder[-1]["rmse_mm"], diag["noise_floor_mm"])
     explained = diag.get("explained")
     explained_text = "-" if explained is None else ("yes" if explained else "**no**")
+    worst = diag.get("worst_cells") or []
+    if worst and explained is False:
+        explained_text += " (worst cell [%d, %d])" % tuple(worst[0])
     return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal),
             ("**%s**" if correct else "%s (WRONG)") % verdict, "<br>".join(ranking), "<br>".join(fitted) or "-",
             surface_text, rmse_text, explained_text, "%.0f" % diag["seconds"], "%.0f" % diag["cpu_seconds"]]
