@@ -3,12 +3,15 @@
 // between cells. Before its scan, each cell of the array is tried: the
 // dataset is replayed with the effect in that cell at each probe of its
 // fitted parameters (halfway to each bound, geometrically for a positive
-// default: cell_defect's factor 0.45 and 2.24), and the cell and probe of
-// lowest sum of squares are where the scan and refit start. Each point's
-// sum of squares is taken with the current model's parameters re-solved
-// along its Jacobian (the residual projected off its columns): a baseline
-// fitted to a soft cell has softened every spring, and a soft probe in the
-// right cell only beats a stiff one elsewhere once k may rise again.
+// default: cell_defect's factor 0.45 and 2.24). Each probe's sum of squares
+// is taken with the current model's parameters re-solved along its
+// Jacobian (the residual projected off its columns): a baseline fitted to a
+// soft cell has softened every spring, and a soft probe in the right cell
+// only beats a stiff one elsewhere once k may rise again. A cell's score is
+// the minimum of the parabola through its probes and the neutral value (in
+// log factor), so a defect between the probes (0.6) is judged at its own
+// size; the best 3 cells by score are then fitted jointly for 2 iterations,
+// and the lowest cost gives the cell and the start of the scan and refit.
 #pragma once
 
 #include <string>
@@ -27,13 +30,14 @@ struct CellSearch {
   int row = -1, col = -1;
   double best_sum_sq_mm2 = 0.0;
   int replays = 0;
-  std::string note;  // "cell_defect at cell [1, 2], factor 0.447 (sum of squares -31.0 %)"
+  std::string note;  // "cell_defect at cell [1, 2], factor 0.41 (best of 3 cells fitted; sum of squares -31.0 %)"
 };
 
 // @param start  the current model with `effect` switched on
 // @param current  the current model's fit (its Jacobian and sum of squares)
-// @throws std::runtime_error if no cell and probe replays
+// @param fit  the least-squares options of the short fits (and their replays)
+// @throws std::runtime_error if no cell and probe replays, or no best cell's fit
 CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const std::vector<FitParameter>& parameters,
-                        const std::string& effect, const LeastSquaresResult& current, const ReplayOptions& replay);
+                        const std::string& effect, const LeastSquaresResult& current, const LeastSquaresOptions& fit);
 
 }  // namespace hj

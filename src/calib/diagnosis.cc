@@ -282,7 +282,7 @@ CandidateFit scanned_candidate(const Selection& s, const std::string& effect) {
     ModelParams start = with_effects(s.current.params, c.effects);
     if (is_cell_effect(effect)) {
       // Which cell: a search no local fit can make (cell_search.h).
-      CellSearch cell = search_cells(s.dataset, start, parameters, effect, s.current, s.options.fit.least_squares.replay);
+      CellSearch cell = search_cells(s.dataset, start, parameters, effect, s.current, s.options.fit.least_squares);
       start = cell.best;
       c.scanned_start = start;
       c.scan_note = cell.note;
