@@ -3,15 +3,16 @@
 // between cells. Before its scan, each cell of the array is tried: the
 // dataset is replayed with the effect in that cell at each probe of its
 // fitted parameters (halfway to each bound, geometrically for a positive
-// default: cell_defect's factor 0.45 and 2.24). Each probe's sum of squares
-// is taken with the current model's parameters re-solved along its
-// Jacobian (the residual projected off its columns): a baseline fitted to a
-// soft cell has softened every spring, and a soft probe in the right cell
-// only beats a stiff one elsewhere once k may rise again. A cell's score is
-// the minimum of the parabola through its probes and the neutral value (in
-// log factor), so a defect between the probes (0.6) is judged at its own
-// size; the best 3 cells by score are then fitted jointly for 2 iterations,
-// and the lowest cost gives the cell and the start of the scan and refit.
+// default: cell_defect's factor 0.45 and 2.24). A probe is scored by the
+// least-squares prediction along its direction with the current model's
+// parameters re-solved along their Jacobian (the residuals projected off
+// its columns): a baseline fitted to a soft cell has softened every
+// spring, and a soft probe in the right cell only beats a stiff one
+// elsewhere once k may rise again. Only the probe's direction counts, so a
+// defect between the probes (0.6) is judged at its own size. The best 3
+// cells by score are then fitted jointly for 4 iterations, from the
+// predicted value and from the probe on its side, and the lowest cost
+// gives the cell and the start of the scan and refit.
 #pragma once
 
 #include <string>
