@@ -192,8 +192,12 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
     finally:
         for proc in (server, emulator):
             if proc:
-                proc.terminate()
-                proc.wait()
+                proc.terminate()  # the server vents; the emulator cuts a settle in progress short
+                try:
+                    proc.wait(timeout=30)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait()
 
 
 def detail(run):
