@@ -245,6 +245,9 @@ struct Selection {
   std::vector<std::string> chosen;
   LeastSquaresResult current;
   double current_heldout = 0.0;
+  // A significant candidate refitted in this round already explains the
+  // data (goodness of fit): the others need no search over their ranges.
+  bool round_explained = false;
 };
 
 // The baseline, fitted the paper's way then jointly, its held-out RMSE, the
@@ -327,10 +330,11 @@ void scan_and_screen(const Selection& s, const std::vector<std::string>& remaini
 // basin the current model's distorted optimum put it in (a strong effect
 // the baseline absorbed): where a short fit from the new parameter's range
 // already beats it, the candidate is refitted in full from there and the
-// better fit kept. A refit that explains the data costs nothing more.
+// better fit kept. A refit that explains the data, or one in a round where
+// a significant candidate already does, costs nothing more.
 void refit_over_range_if_unexplained(const Selection& s, const std::vector<FitParameter>& parameters,
                                      const LeastSquaresProgress& progress, CandidateFit& c) {
-  if (goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) return;
+  if (s.round_explained || goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) return;
   const std::optional<ModelParams> start = better_start_than_local(s.dataset, c.fit, s.options, s.progress, c);
   if (!start) return;
   CandidateFit from_range = c;
@@ -385,6 +389,7 @@ void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::ve
     return expected_rmse(a) < expected_rmse(b);
   });
   double best_heldout = std::numeric_limits<double>::infinity();
+  s.round_explained = false;
   for (CandidateFit& c : to_refit) {
     if (s.options.screening && s.options.refit_cutoff > 0.0 &&
         expected_rmse(c) > s.options.refit_cutoff * best_heldout) {
@@ -393,6 +398,8 @@ void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::ve
       continue;
     }
     if (!refit_candidate(s, on, c)) continue;
+    if (c.significant && goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained)
+      s.round_explained = true;
     if (c.significant && c.heldout_rmse_mm < best_heldout) {
       best_heldout = c.heldout_rmse_mm;
       fits.insert(fits.begin(), std::move(c));
