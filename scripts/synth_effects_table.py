@@ -65,6 +65,33 @@ def fitted_value(diag, effect, name):
     return None, ""
 
 
+STAGES = ("scan", "screening", "candidate", "multi-start", "cross-validation", "converging", "recheck")
+
+
+def time_by_stage(path):
+    """CPU seconds per stage kind from diagnose.log's "time in STAGE ..." lines,
+    the three largest as "multi-start 96, candidate 80, scan 61"."""
+    totals = {}
+    try:
+        lines = open(path).read().splitlines()
+    except OSError:
+        return ""
+    for line in lines:
+        line = line.strip()
+        if not line.startswith("time in "):
+            continue
+        name, _, rest = line[len("time in "):].partition("  ")
+        words = rest.split()
+        try:
+            cpu = float(words[words.index("CPU") - 2])
+        except (ValueError, IndexError):
+            continue
+        kind = next((k for k in STAGES if name.startswith(k)), "baseline")
+        totals[kind] = totals.get(kind, 0.0) + cpu
+    top = sorted(totals.items(), key=lambda kv: -kv[1])[:3]
+    return ", ".join("%s %.0f" % kv for kv in top)
+
+
 def row(work, case):
     base = os.path.join(work, case)
     truth = load(os.path.join(base, "data", "truth.json"))
@@ -79,7 +106,7 @@ def row(work, case):
     floor = summary.get("noise_floor_mm", 1.04) if summary else 1.04
     signal = math.sqrt(max(rmse * rmse - floor * floor, 0.0)) if summary else float("nan")
     if diag is None:
-        return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal), "not run", "", "", "", "", "", "", ""]
+        return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal), "not run", "", "", "", "", "", "", "", ""]
     verdict = ", ".join(diag["verdict"]) or "none"
     expected = expected_verdict(truth)
     correct = sorted(diag["verdict"]) == expected
@@ -112,7 +139,8 @@ def row(work, case):
         explained_text += " (worst cell [%d, %d])" % tuple(worst[0])
     return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal),
             ("**%s**" if correct else "%s (WRONG)") % verdict, "<br>".join(ranking), "<br>".join(fitted) or "-",
-            surface_text, rmse_text, explained_text, "%.0f" % diag["seconds"], "%.0f" % diag["cpu_seconds"]]
+            surface_text, rmse_text, explained_text, "%.0f" % diag["seconds"], "%.0f" % diag["cpu_seconds"],
+            time_by_stage(os.path.join(base, "diagnose.log"))]
 
 
 def main():
@@ -121,7 +149,7 @@ def main():
     work, sessions, cases = sys.argv[1], sys.argv[2], sys.argv[3:]
     head = ["dataset", "true effects", "true parameters", "RMSE vs baseline mm (effect alone)", "verdict",
             "ranking top 3: delta BIC (* significant, s screened out)", "fitted vs true", "final m kg, k N/m, kappa_jam",
-            "RMSE mm baseline -> final", "explained", "wall s", "CPU s"]
+            "RMSE mm baseline -> final", "explained", "wall s", "CPU s", "CPU s by stage (top 3)"]
     print("Sessions of demo-baseline replayed: %s." % sessions.replace(",", ", "))
     print()
     print("| " + " | ".join(head) + " |")
