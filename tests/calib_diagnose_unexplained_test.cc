@@ -36,6 +36,14 @@ void add_camera_bump(const fs::path& data) {
   }
 }
 
+// The tiny sessions replayed with the true baseline, the bump added.
+Dataset bump_dataset(const fs::path& dir) {
+  testing_support::write_tiny_sessions(dir / "sessions");
+  synthesize_dataset(dir / "sessions", dir / "data", testing_support::true_tiny_baseline(), SynthOptions{});
+  add_camera_bump(dir / "data");
+  return read_dataset(dir / "data");
+}
+
 TEST(GoodnessOfFit, ChiSquareTailMatchesKnownQuantiles) {
   // chi2_{1000}: the 95th percentile is 1074.68, the median 999.33.
   EXPECT_NEAR(chi_square_upper_tail(1074.68, 1000), 0.05, 1e-3);
@@ -57,11 +65,7 @@ TEST(GoodnessOfFit, ChiSquareTailMatchesKnownQuantiles) {
 
 TEST(CalibDiagnoseUnexplained, AnEffectNoCandidateHasIsNotExplainedAway) {
   testing_support::ScratchDir scratch("bump");
-  testing_support::write_tiny_sessions(scratch.path / "sessions");
-  synthesize_dataset(scratch.path / "sessions", scratch.path / "data", testing_support::true_tiny_baseline(),
-                     SynthOptions{});
-  add_camera_bump(scratch.path / "data");
-  const Dataset d = read_dataset(scratch.path / "data");
+  const Dataset d = bump_dataset(scratch.path);
   DiagnoseOptions o;
   o.candidates = {"sensor_tilt", "pressure_offset", "cell_stiffness"};
   o.max_effects = 1;
@@ -83,11 +87,7 @@ TEST(CalibDiagnoseUnexplained, AnEffectNoCandidateHasIsNotExplainedAway) {
 // it is judged; the search does not explain the bump away either.
 TEST(CalibDiagnoseUnexplained, AnUnexplainedRefitIsSearchedOverItsParametersRange) {
   testing_support::ScratchDir scratch("bump-range");
-  testing_support::write_tiny_sessions(scratch.path / "sessions");
-  synthesize_dataset(scratch.path / "sessions", scratch.path / "data", testing_support::true_tiny_baseline(),
-                     SynthOptions{});
-  add_camera_bump(scratch.path / "data");
-  const Dataset d = read_dataset(scratch.path / "data");
+  const Dataset d = bump_dataset(scratch.path);
   DiagnoseOptions o;
   o.candidates = {"stiffening"};
   o.max_effects = 1;
