@@ -46,7 +46,7 @@ struct CellScore {
   int row, col;
   double predicted = std::numeric_limits<double>::infinity();
   double value = 0.0;
-  std::vector<const Point*> probes;  // the probe that predicts it
+  const Point* probe = nullptr;  // the probe that predicts it
 };
 
 // The score along one probe: with d = r(probe) - r0 and both taken off the
@@ -75,8 +75,8 @@ void predict_along_probe(const Eigen::VectorXd& r0_off, const Eigen::VectorXd& r
 std::vector<CellScore> rank_cells(const std::vector<Point>& points) {
   std::map<std::pair<int, int>, CellScore> by_cell;
   for (const Point& p : points) {
-    CellScore& score = by_cell.try_emplace({p.row, p.col}, CellScore{p.row, p.col, std::numeric_limits<double>::infinity(), 0.0, {}}).first->second;
-    if (p.predicted < score.predicted) score.predicted = p.predicted, score.value = p.predicted_value, score.probes = {&p};
+    CellScore& score = by_cell.try_emplace({p.row, p.col}, CellScore{p.row, p.col, std::numeric_limits<double>::infinity(), 0.0, nullptr}).first->second;
+    if (p.predicted < score.predicted) score.predicted = p.predicted, score.value = p.predicted_value, score.probe = &p;
   }
   std::vector<CellScore> out;
   for (const auto& [cell, score] : by_cell) out.push_back(score);
@@ -153,7 +153,8 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
     if (!std::isfinite(cell.predicted)) break;
     // From the predicted value and from the probe on its side: where the
     // current fit is far from the truth the linear prediction falls short.
-    for (const Point* from : cell.probes) {
+    {
+      const Point* from = cell.probe;
       for (double value : {cell.value, from->value}) {
         ModelParams m = start;
         m.effect_parameters[effect]["row"] = cell.row;
