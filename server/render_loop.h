@@ -13,9 +13,9 @@
 #include <string>
 
 #include "auth.h"
-#include "plan/default_planner.h"
 #include "device_queue.h"
 #include "hapticjam/v1/render_service.pb.h"
+#include "plan/default_planner.h"
 #include "proto_convert.h"
 
 namespace hj::server {

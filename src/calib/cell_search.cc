@@ -153,28 +153,25 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
     if (!std::isfinite(cell.predicted)) break;
     // From the predicted value and from the probe on its side: where the
     // current fit is far from the truth the linear prediction falls short.
-    {
-      const Point* from = cell.probe;
-      for (double value : {cell.value, from->value}) {
-        ModelParams m = start;
-        m.effect_parameters[effect]["row"] = cell.row;
-        m.effect_parameters[effect]["col"] = cell.col;
-        for (const auto& p : parameters)
-          if (!p.surface && p.effect == effect) set_parameter_value(m, p, value);
-        try {
-          LeastSquaresResult r = fit_least_squares(dataset, m, parameters, short_fit);
-          out.replays += r.evaluations + r.jacobians * r.free_parameters;
-          if (r.sum_sq_mm2 < best_cost) {
-            best_cost = r.sum_sq_mm2;
-            out.best = std::move(r.params);
-            out.row = cell.row;
-            out.col = cell.col;
-          }
-        } catch (const SettleInterrupted&) {
-          throw;
-        } catch (const std::exception&) {
-          // This start does not replay: the next one.
+    for (double value : {cell.value, cell.probe->value}) {
+      ModelParams m = start;
+      m.effect_parameters[effect]["row"] = cell.row;
+      m.effect_parameters[effect]["col"] = cell.col;
+      for (const auto& p : parameters)
+        if (!p.surface && p.effect == effect) set_parameter_value(m, p, value);
+      try {
+        LeastSquaresResult r = fit_least_squares(dataset, m, parameters, short_fit);
+        out.replays += r.evaluations + r.jacobians * r.free_parameters;
+        if (r.sum_sq_mm2 < best_cost) {
+          best_cost = r.sum_sq_mm2;
+          out.best = std::move(r.params);
+          out.row = cell.row;
+          out.col = cell.col;
         }
+      } catch (const SettleInterrupted&) {
+        throw;
+      } catch (const std::exception&) {
+        // This start does not replay: the next one.
       }
     }
   }

@@ -139,9 +139,13 @@ std::string Emulator::vent(std::uint64_t id) {
 }
 
 void Emulator::reset_to_rest() {
-  limit_->resetting = true;
+  // Cleared on every way out, so a throwing constructor cannot leave settles uninterruptible.
+  struct Resetting {
+    SettleLimit& limit;
+    explicit Resetting(SettleLimit& l) : limit(l) { limit.resetting = true; }
+    ~Resetting() { limit.resetting = false; }
+  } resetting(*limit_);
   simulator_ = Simulator(config_.geometry, config_.params, config_.simulator);
-  limit_->resetting = false;
 }
 
 protocol::StatusPayload Emulator::status() const {

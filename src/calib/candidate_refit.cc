@@ -1,0 +1,148 @@
+#include "calib/candidate_refit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "calib/candidate_screening.h"
+#include "calib/goodness_of_fit.h"
+#include "calib/range_start.h"
+
+namespace hj {
+
+bool is_significant(const CandidateFit& c, const LeastSquaresResult& current, double reference_heldout_mm,
+                    const DiagnoseOptions& options) {
+  return c.heldout_rmse_mm <= (1.0 - options.min_heldout_gain) * reference_heldout_mm &&
+         c.delta_bic < options.max_delta_bic && c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm;
+}
+
+namespace {
+
+LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& current, const CandidateFit& c,
+                                 const std::vector<FitParameter>& parameters, const DiagnoseOptions& options,
+                                 const LeastSquaresProgress& progress) {
+  const std::vector<ModelParams> starts = candidate_starts(c, current, parameters);
+  for (size_t k = 0;; ++k) {
+    try {
+      return fit_least_squares(dataset, starts[k], parameters, options.fit.least_squares, progress);
+    } catch (const SettleInterrupted&) {
+      throw;  // the caller stopped the work: not a failed replay
+    } catch (const std::exception&) {
+      if (k + 1 == starts.size()) throw;
+    }
+  }
+}
+
+// What a candidate's refit is expected to reach: the screening's predicted
+// RMSE, or where its linearisation says nothing (a start far from neutral),
+// the RMSE at the scan's best point, where the refit starts; infinity if
+// neither is known (then it is refitted last, and always).
+double expected_rmse(const CandidateFit& c) {
+  if (c.screened) return c.predicted_rmse_mm;
+  return std::isfinite(c.scan_rmse_mm) ? c.scan_rmse_mm : std::numeric_limits<double>::infinity();
+}
+
+// A candidate not refitted because the RMSE its refit is expected to reach
+// is more than refit_cutoff times the held-out RMSE of a significant one
+// already refitted in this round: it keeps the expected figures and a
+// note, as a screened-out candidate does.
+void outrun(CandidateFit& c, const LeastSquaresResult& current, double best_heldout, const std::string& best) {
+  const double expected = expected_rmse(c);
+  c.fit = LeastSquaresResult{};
+  c.fit.params = c.scanned_start ? *c.scanned_start : with_effects(current.params, c.effects);
+  c.fit.rmse_mm = expected;
+  c.heldout_rmse_mm = c.screened ? c.predicted_heldout_rmse_mm : expected;
+  c.delta_bic = c.screened ? c.predicted_delta_bic : std::numeric_limits<double>::quiet_NaN();
+  c.significant = false;
+  c.screened_out = true;
+  char note[240];
+  std::snprintf(note, sizeof note,
+                "not refitted: its %s RMSE %.3f mm cannot come near %s's refitted held-out RMSE %.3f mm",
+                c.screened ? "predicted" : "scanned", expected, best.c_str(), best_heldout);
+  c.screening_note = note;
+}
+
+// A local refit that leaves the data unexplained may have stopped in the
+// basin the current model's distorted optimum put it in (a strong effect
+// the baseline absorbed): where a short fit from the new parameter's range
+// already beats it, the candidate is refitted in full from there and the
+// better fit kept. A refit that explains the data, or one in a round where
+// a significant candidate already does, costs nothing more.
+void refit_over_range_if_unexplained(const Selection& s, const std::vector<FitParameter>& parameters,
+                                     const LeastSquaresProgress& progress, CandidateFit& c) {
+  if (s.round_explained || goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) return;
+  const std::optional<ModelParams> start = better_start_than_local(s.dataset, c.fit, s.options, s.progress, c);
+  if (!start) return;
+  CandidateFit from_range = c;
+  from_range.scanned_start = *start;
+  LeastSquaresResult again = fit_candidate(s.dataset, s.current.params, from_range, parameters, s.options, progress);
+  if (again.sum_sq_mm2 < c.fit.sum_sq_mm2) {
+    c.fit = std::move(again);
+    c.scanned_start = *start;
+  }
+}
+
+// Refits one candidate from the current optimum, cross-validates it and
+// judges it; false (and said so in out.skipped) if the model cannot replay it.
+bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
+  const std::string& effect = c.added;
+  const auto parameters = fit_parameters(c.effects);
+  // One progress stage per candidate, so that its time shows apart.
+  const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
+  const DiagnoseProgress& progress = s.progress;
+  // Warm start: the current model's optimum, the new effect where the scan
+  // found it best, or where the best short fit over its range ended.
+  try {
+    const LeastSquaresProgress fit_progress = [&](int iteration, int max_iterations, double rmse) {
+      if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
+    };
+    if (s.options.multi_start_before_refit) start_from_best_of_range(s.dataset, s.current.params, s.options, progress, c);
+    c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options, fit_progress);
+    if (!s.options.multi_start_before_refit) refit_over_range_if_unexplained(s, parameters, fit_progress, c);
+    if (progress) progress("cross-validation", 0, 1, effect);
+    c.heldout_rmse_mm = cross_validate(s.dataset, parameters, c.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
+    c.delta_bic = bic(c.fit) - bic(s.current);
+    c.significant = is_significant(c, s.current, s.current_heldout, s.options);
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
+  } catch (const std::exception& e) {
+    s.out.skipped.push_back(effect + ": " + e.what());
+    return false;
+  }
+  if (progress)
+    progress(stage, s.options.fit.least_squares.max_iterations, s.options.fit.least_squares.max_iterations,
+             "held out " + std::to_string(c.heldout_rmse_mm) + " mm");
+  return true;
+}
+
+}  // namespace
+
+void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits) {
+  std::string on;
+  for (const auto& e : s.chosen) on += " + " + e;
+  std::stable_sort(to_refit.begin(), to_refit.end(), [](const CandidateFit& a, const CandidateFit& b) {
+    return expected_rmse(a) < expected_rmse(b);
+  });
+  double best_heldout = std::numeric_limits<double>::infinity();
+  s.round_explained = false;
+  for (CandidateFit& c : to_refit) {
+    if (s.options.screening && s.options.refit_cutoff > 0.0 &&
+        expected_rmse(c) > s.options.refit_cutoff * best_heldout) {
+      outrun(c, s.current, best_heldout, fits.front().added);
+      fits.push_back(std::move(c));
+      continue;
+    }
+    if (!refit_candidate(s, on, c)) continue;
+    if (c.significant && goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained)
+      s.round_explained = true;
+    if (c.significant && c.heldout_rmse_mm < best_heldout) {
+      best_heldout = c.heldout_rmse_mm;
+      fits.insert(fits.begin(), std::move(c));
+    } else {
+      fits.push_back(std::move(c));
+    }
+  }
+}
+
+}  // namespace hj

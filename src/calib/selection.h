@@ -1,0 +1,40 @@
+// The greedy forward selection diagnose() runs (diagnosis.cc), shared by
+// its steps: the candidates' refits (candidate_refit.cc) and the rounds.
+// Internal to diagnose.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/diagnosis.h"
+
+namespace hj {
+
+// The greedy forward selection diagnose() runs: the effects chosen so far
+// and the fit of the model they make, against which candidates are judged.
+struct Selection {
+  const Dataset& dataset;
+  const DiagnoseOptions& options;
+  const DiagnoseProgress& progress;
+  Diagnosis& out;
+  std::vector<std::string> chosen;
+  LeastSquaresResult current;
+  double current_heldout = 0.0;
+  // A significant candidate refitted in this round already explains the
+  // data (goodness of fit): the others need no search over their ranges.
+  bool round_explained = false;
+};
+
+// Significance. BIC's penalty is ln n per parameter (about 12 for the
+// 1.7e5 samples of a six-session dataset); delta BIC below -10 is "very
+// strong" evidence on the Kass-Raftery scale. With that many samples BIC
+// alone would still accept an effect that only soaks up a systematic
+// misfit of a few hundredths of a mm, so the effect must also lower the
+// error on sessions it was not fitted to by a real margin: 1 % of the RMSE
+// is about six standard errors of an RMSE estimated from 1.7e5 samples
+// (relative s.e. 1 / sqrt(2 n)), and far less than any effect worth
+// modelling changes.
+bool is_significant(const CandidateFit& c, const LeastSquaresResult& current, double reference_heldout_mm,
+                    const DiagnoseOptions& options);
+
+}  // namespace hj
