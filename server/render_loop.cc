@@ -12,6 +12,7 @@
 #include "render_calibration.h"
 #include "service_error.h"
 #include "sim/settle_report.h"
+#include "sim/simulator.h"
 
 namespace hj::server {
 
@@ -64,6 +65,12 @@ SessionGrid session_grid(const v1::CaptureGrid& g) {
 // The predicted surface as the camera would see it at the rest points: like with like.
 Eigen::MatrixXd predicted_at_rest_points(const Mesh& mesh, const Eigen::Matrix3Xd& x, const v1::CaptureGrid& g) {
   return frame_at_rest_points(mesh, rasterize_top_view(mesh, x, session_grid(g)), frame_grid(g));
+}
+
+// A job the device failed at one of the plan's actions after carrying out
+// at least one (not at the capture, and not cancelled or interrupted).
+bool refused_part_way(const v1::Job& job, size_t actions) {
+  return job.state() == v1::JOB_STATE_FAILED && job.steps_done() > 0 && size_t(job.steps_done()) < actions;
 }
 
 bool learns_targets(v1::RenderCorrection c) {
@@ -156,12 +163,21 @@ class RenderRun {
     hooks_.emit(std::move(event));
   }
 
-  PlanResult plan(int iteration) {
-    // The fitted model (the request's until a fit), its camera left out: a planner plans surfaces.
+  // The fitted model (the request's until a fit), its camera left out: a planner plans surfaces.
+  struct PlanningModel {
+    SurfaceParameters surface;
+    SimulatorOptions simulator;
+  };
+  PlanningModel planning_model() const {
     const ModelParams model = without_measurement_effects(calibration_.model());
-    SimulatorOptions simulator = setup_.array.simulator;
-    model.apply_to(simulator);
-    PlanRequest request{setup_.array.geometry, model.surface, targets_, simulator, {}};
+    PlanningModel out{model.surface, setup_.array.simulator};
+    model.apply_to(out.simulator);
+    return out;
+  }
+
+  PlanResult plan(int iteration) {
+    const PlanningModel model = planning_model();
+    PlanRequest request{setup_.array.geometry, model.surface, targets_, model.simulator, {}};
     PlanCallbacks callbacks;
     callbacks.cancelled = hooks_.cancelled;
     callbacks.progress = [&](double fraction, const std::string& what) {
@@ -175,15 +191,31 @@ class RenderRun {
     }
   }
 
-  // Submits the plan and a capture; waits for the job to end; its capture.
-  v1::Job run_on_device(int iteration, const PlanResult& planned, v1::Plan* plan) {
-    for (const Action& a : planned.steps) action_to_proto(a, plan->add_steps());
-    plan->set_planner(setup_.planner);
-    v1::Plan with_capture = *plan;
+  // The planning model's surface after `steps` from rest: the prediction
+  // for a run the device cut short.
+  DeviceState predicted_after(int iteration, const std::vector<Action>& steps) const {
+    PlanningModel model = planning_model();
+    model.simulator.interrupted = hooks_.cancelled;
+    Simulator simulator(setup_.array.geometry, model.surface, model.simulator);
+    try {
+      for (const Action& a : steps) simulator.apply(a);
+    } catch (const SettleInterrupted&) {
+      throw ServiceError(StatusCode::CANCELLED, "the render was cancelled while predicting iteration " +
+                                                    std::to_string(iteration) + "'s shortened run");
+    }
+    return simulator.state();
+  }
+
+  // Submits `steps` and a capture as one device job; waits for it to end.
+  v1::Job run_on_device(int iteration, const std::vector<Action>& steps, const std::string& which) {
+    v1::Plan with_capture;
+    for (const Action& a : steps) action_to_proto(a, with_capture.add_steps());
+    with_capture.set_planner(setup_.planner);
+    const std::string name = setup_.name + " iteration " + std::to_string(iteration) + which;
     v1::Step* capture = with_capture.add_steps();
     capture->mutable_capture();
-    capture->set_label(setup_.name + " iteration " + std::to_string(iteration));
-    const v1::Job queued = queue_.submit(caller_, setup_.name + " iteration " + std::to_string(iteration), with_capture);
+    capture->set_label(name);
+    const v1::Job queued = queue_.submit(caller_, name, with_capture);
     log_event("render_job", {{"job", queued.id()}, {"iteration", iteration}});
     std::uint64_t seen = 0;
     bool cancel_sent = false;
@@ -213,8 +245,27 @@ class RenderRun {
     const PlanResult planned = plan(i);
     it.set_planning_seconds(seconds_since(planning_start));
 
+    for (const Action& a : planned.steps) action_to_proto(a, it.mutable_plan()->add_steps());
+    it.mutable_plan()->set_planner(setup_.planner);
+
     const auto device_start = Clock::now();
-    const v1::Job job = run_on_device(i, planned, it.mutable_plan());
+    std::vector<Action> steps = planned.steps;
+    DeviceState predicted_state = planned.final_state;
+    v1::Job job = run_on_device(i, steps, "");
+    if (refused_part_way(job, steps.size())) {
+      // The device could not complete a step its model settles (a device
+      // is not the model): this iteration ends where the device stood, and
+      // the correction works on what it did make.
+      it.set_refusal(job.error());
+      it.set_refused_job_id(job.id());
+      steps.resize(size_t(job.steps_done()));
+      log_event("render_step_refused", {{"job", job.id()}, {"iteration", i}, {"step", job.steps_done()}});
+      progress(i, 0.5, "the device refused step " + std::to_string(job.steps_done()) + "; running the " +
+                           std::to_string(steps.size()) + " steps before it");
+      predicted_state = predicted_after(i, steps);
+      job = run_on_device(i, steps, " (first " + std::to_string(steps.size()) + " steps)");
+    }
+    it.set_steps_run(int(steps.size()));
     it.set_device_seconds(seconds_since(device_start));
     it.set_job_id(job.id());
     if (job.state() != v1::JOB_STATE_DONE || job.captures_size() == 0) {
@@ -227,10 +278,10 @@ class RenderRun {
     *it.mutable_capture() = job.captures(job.captures_size() - 1);
 
     const Eigen::MatrixXd frame = frame_heights(it.capture());
-    if (fits_model(setup_.correction)) fit_model(i, planned.steps, frame, it);
+    if (fits_model(setup_.correction)) fit_model(i, steps, frame, it);
     const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame, frame_grid(it.capture().grid()));
     const Eigen::MatrixXd measured = calibrated(i, seen, it.mutable_camera());
-    const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, planned.final_state.x, it.capture().grid());
+    const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, predicted_state.x, it.capture().grid());
     it.set_point_rows(mesh_.point_rows()), it.set_point_cols(mesh_.point_cols());
     add_heights(measured, it.mutable_measured_heights_mm());
     add_heights(predicted, it.mutable_predicted_heights_mm());

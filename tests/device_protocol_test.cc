@@ -57,11 +57,13 @@ TEST(DeviceProtocol, EveryRequestRoundTripsExactly) {
     r.command = c;
     requests.push_back(r);
   }
-  for (const auto kind : {protocol::Fault::Kind::kDrop, protocol::Fault::Kind::kStall, protocol::Fault::Kind::kMute}) {
+  for (const auto kind : {protocol::Fault::Kind::kDrop, protocol::Fault::Kind::kStall, protocol::Fault::Kind::kMute,
+                          protocol::Fault::Kind::kRefuse}) {
     Request r;
     r.id = 3;
     r.command = Command::kFault;
-    r.fault = {kind, kind == protocol::Fault::Kind::kDrop ? 0 : 1500};
+    const bool timed = kind == protocol::Fault::Kind::kStall || kind == protocol::Fault::Kind::kMute;
+    r.fault = {kind, timed ? 1500 : 0, kind == protocol::Fault::Kind::kRefuse ? 4 : 0};
     requests.push_back(r);
   }
   for (const Request& r : requests) {
@@ -79,6 +81,7 @@ TEST(DeviceProtocol, EveryRequestRoundTripsExactly) {
     if (r.command == Command::kFault) {
       EXPECT_EQ(back.fault.kind, r.fault.kind);
       EXPECT_EQ(back.fault.ms, r.fault.ms);
+      EXPECT_EQ(back.fault.actions, r.fault.actions);
     }
   }
 }
@@ -124,6 +127,8 @@ TEST(DeviceProtocol, MalformedRequestsNameWhatIsWrong) {
       {"7 fault stall", ErrorCode::kMalformed, 7, {"fault stall takes one value"}},
       {"7 fault stall -5", ErrorCode::kMalformed, 7, {"fault duration", "outside", "600000"}},
       {"7 fault drop now", ErrorCode::kMalformed, 7, {"fault drop takes no value"}},
+      {"7 fault refuse", ErrorCode::kMalformed, 7, {"fault refuse takes one value"}},
+      {"7 fault refuse 0", ErrorCode::kMalformed, 7, {"fault refuse action count", "outside"}},
       {"", ErrorCode::kMalformed, 0, {"empty line"}},
       {"7 " + std::string(2000, 'x'), ErrorCode::kTooLong, 0, {"2002 bytes", "1024"}},
       {"7 jam \x01\x02 1", ErrorCode::kMalformed, 7, {"\"??\""}},

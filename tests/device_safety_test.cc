@@ -101,6 +101,21 @@ TEST(DeviceSafety, AVentOvertakesHeldCommandsWhichAreNotCarriedOut) {
   EXPECT_EQ(device.server.vents()[0].why, "vent");
 }
 
+TEST(DeviceSafety, ARefusedActionIsNotCarriedOutAndTheNextOnesAre) {
+  EmulatedDevice device;
+  LineClient client(device.server.port());
+  client.send("1 fault refuse 2");
+  EXPECT_EQ(client.reply_to(1), "ok 1");
+  client.send("2 set_pressure 500");
+  EXPECT_EQ(client.reply_to(2), "ok 2");
+  client.send("3 set_pressure 900");
+  const std::string refused = client.reply_to(3);
+  EXPECT_EQ(refused.rfind("err 3 failed set_pressure 900: refused", 0), 0u) << refused;
+  EXPECT_EQ(pressure_of(client, 4), "ok 4 pressure_pa=500") << "the state is as before the refused action";
+  client.send("5 set_pressure 900");
+  EXPECT_EQ(client.reply_to(5), "ok 5") << "refused once";
+}
+
 TEST(DeviceSafety, TheEmulatorVentsByItselfWhenTheServerFallsSilent) {
   EmulatedDevice device(with_watchdog(300ms));
   LineClient client(device.server.port());

@@ -5,6 +5,7 @@
 // make (its own surface after a known sequence), so the loop can reach it.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -153,6 +154,39 @@ TEST(RenderE2e, AnArraySizeOtherThanTheDevicesIsRefusedBeforeAnythingRuns) {
                           "--heights", "absolute", "--json"});
   EXPECT_EQ(r.code, 19) << r.err;  // FAILED_PRECONDITION
   EXPECT_NE(r.err.find("3 x 4"), std::string::npos) << r.err;
+}
+
+// A device is not the model: a step it cannot complete (here the emulator's
+// injected refusal of the 4th action) ends that iteration where the device
+// stood, captured and corrected there, and the loop goes on; the queue is
+// not paused, since a refusal is not a fault.
+TEST(RenderE2e, AStepTheDeviceRefusesEndsThatIterationWhereItStoodAndTheLoopGoesOn) {
+  RenderRig rig;
+  ASSERT_TRUE(wait_until([&] { return rig.connected(); })) << rig.server->process->err();
+  {
+    EmulatorLine line(rig.emulator->port);
+    const std::string armed = line.request("fault refuse 4");
+    ASSERT_EQ(armed.rfind("ok", 0), 0u) << armed;
+  }
+  const auto r = rig.cli({"render", (rig.dir.path / "goal.csv").string(), "--rows", "3", "--cols", "4",
+                          "--iterations", "2", "--heights", "absolute", "--json", "--out",
+                          (rig.dir.path / "render").string()});
+  ASSERT_EQ(r.code, 0) << r.err << rig.server->process->err();
+  const auto lines = json_lines(r.out);
+  ASSERT_EQ(lines.size(), 3u) << r.out;
+  const json& first = lines[0];
+  ASSERT_TRUE(first["refusal"].is_string()) << first;
+  EXPECT_NE(first["refusal"].get<std::string>().find("refused"), std::string::npos) << first;
+  EXPECT_EQ(first["steps_run"], 3) << first;
+  EXPECT_TRUE(std::isfinite(first["mae_mm"].get<double>())) << first;
+  EXPECT_TRUE(lines[1]["refusal"].is_null()) << lines[1];
+  EXPECT_GT(lines[1]["steps_run"].get<int>(), 3) << lines[1];
+  EXPECT_EQ(lines[2]["result"]["iterations"], 2) << lines[2];
+  const json plan = json::parse(testing_support::read_file(rig.dir.path / "render" / "iteration-1" / "plan.json"));
+  EXPECT_EQ(plan["steps_run"], 3) << plan;
+  EXPECT_GT(plan["refused_job_id"].get<long>(), 0) << plan;
+  const auto status = rig.cli({"status", "--json"});
+  EXPECT_FALSE(json::parse(status.out).value("queue_paused", true)) << status.out;
 }
 
 // An emergency stop during an iteration's job ends the render (ABORTED,

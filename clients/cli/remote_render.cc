@@ -110,7 +110,9 @@ void write_iteration(const fs::path& out, const v1::RenderIteration& it) {
   const fs::path dir = out / ("iteration-" + std::to_string(it.iteration()));
   fs::create_directories(dir);
   nlohmann::json plan = nlohmann::json::parse(to_json_line(it.plan()));
-  std::ofstream(dir / "plan.json") << nlohmann::json{{"job_id", it.job_id()}, {"plan", plan}}.dump(1) << "\n";
+  nlohmann::json doc{{"job_id", it.job_id()}, {"steps_run", it.steps_run()}, {"plan", plan}};
+  if (!it.refusal().empty()) doc["refusal"] = it.refusal(), doc["refused_job_id"] = it.refused_job_id();
+  std::ofstream(dir / "plan.json") << doc.dump(1) << "\n";
   write_frame_csv(dir / "capture.csv", frame_heights(it.capture()));
   write_frame_csv(dir / "measured.csv", points(it.measured_heights_mm(), it.point_rows(), it.point_cols()));
   write_frame_csv(dir / "predicted.csv", points(it.predicted_heights_mm(), it.point_rows(), it.point_cols()));
@@ -131,6 +133,8 @@ nlohmann::json iteration_line(const v1::RenderIteration& it) {
           {"model", model_json(it.model())},
           {"fitting_seconds", it.fitting_seconds()},
           {"job_id", it.job_id()},
+          {"steps_run", it.steps_run()},
+          {"refusal", it.refusal().empty() ? nlohmann::json(nullptr) : nlohmann::json(it.refusal())},
           {"planning_seconds", it.planning_seconds()},
           {"device_seconds", it.device_seconds()}};
 }
@@ -185,6 +189,9 @@ int remote_render(const RemoteRenderArgs& args) {
                      it.iteration(), it.error().mae_mm(), it.error().rmse_mm(),
                      it.error().has_correlation() ? std::to_string(it.error().correlation()).substr(0, 6).c_str() : "-",
                      it.prediction_error().mae_mm(), it.correction().c_str());
+        if (!it.refusal().empty())
+          std::fprintf(stderr, "  the device refused step %d of %d (%s): captured after the steps before it\n",
+                       it.steps_run(), it.plan().steps_size(), it.refusal().c_str());
       }
     } else if (event.has_result()) {
       result = event.result();

@@ -41,6 +41,7 @@ struct DeviceCommand {
   protocol::Request request;
   bool answers = true;
   bool overtaken = false;  // a vent came while it ran: answered "cancelled"
+  bool refused = false;    // `fault refuse` picked it: answered "failed", not carried out
 };
 
 bool blank(std::string_view line) { return line.find_first_not_of(" \t") == std::string_view::npos; }
@@ -71,6 +72,7 @@ struct EmulatorServer::Impl {
   long counted = 0;
   bool dropped_once = false;
   Clock::time_point mute_until{};
+  int refuse_in = 0;  // `fault refuse N`: the action this many from now is refused; 0 none
   Clock::time_point last_heard = Clock::now();
 
   // The device worker: one command at a time.
@@ -132,6 +134,7 @@ struct EmulatorServer::Impl {
       case Command::kFault:
         if (r.fault.kind == Fault::Kind::kDrop) return close(c);
         write(c, protocol::format_ok(r.id));
+        if (r.fault.kind == Fault::Kind::kRefuse) refuse_in = r.fault.actions;
         if (r.fault.kind == Fault::Kind::kStall) stall(std::chrono::milliseconds(r.fault.ms));
         else mute_until = Clock::now() + std::chrono::milliseconds(r.fault.ms);
         return;
@@ -153,6 +156,7 @@ struct EmulatorServer::Impl {
     command->connection = c;
     command->request = r;
     if (r.command == Command::kAction) c->actuated = true;
+    if (r.command == Command::kAction && refuse_in > 0) command->refused = --refuse_in == 0;
     std::lock_guard lock(mutex);
     if (r.command == Command::kAction) record_action(line);
     jobs.push_back(std::move(command));
@@ -272,6 +276,13 @@ struct EmulatorServer::Impl {
   std::string last_reply;  // worker thread only
 
   void carry_out(const DeviceCommand& command) {
+    if (command.refused) {
+      const std::string action = protocol::format_request(command.request);
+      last_reply = protocol::format_err(command.request.id, protocol::ErrorCode::kFailed,
+                                        action.substr(action.find(' ') + 1) +
+                                            ": refused (fault refuse); the state is as before it");
+      return;
+    }
     try {
       // A vent that overtakes the command, or the server stopping, ends its settle.
       last_reply = emulator.handle(command.request, [this, &command] {

@@ -222,6 +222,7 @@ std::string format_request(const Request& r) {
         case Fault::Kind::kDrop: return out + "fault drop";
         case Fault::Kind::kStall: return out + "fault stall " + std::to_string(r.fault.ms);
         case Fault::Kind::kMute: return out + "fault mute " + std::to_string(r.fault.ms);
+        case Fault::Kind::kRefuse: return out + "fault refuse " + std::to_string(r.fault.actions);
       }
   }
   throw std::logic_error("format_request: unknown command");
@@ -271,7 +272,7 @@ Request parse_request(std::string_view line) {
   } else if (name == "unpin") {
     action(Action::Op::kUnpin, "A B", "node a", "node b", -1'000'000);
   } else if (name == "fault") {
-    if (words.size() < 3) malformed(r.id, "fault needs a kind: drop, stall MS or mute MS");
+    if (words.size() < 3) malformed(r.id, "fault needs a kind: drop, stall MS, mute MS or refuse N");
     r.command = Command::kFault;
     if (words[2] == "drop") {
       if (words.size() != 3) malformed(r.id, "fault drop takes no value");
@@ -280,8 +281,12 @@ Request parse_request(std::string_view line) {
       if (words.size() != 4) malformed(r.id, "fault " + std::string(words[2]) + " takes one value (MS)");
       r.fault.kind = words[2] == "stall" ? Fault::Kind::kStall : Fault::Kind::kMute;
       r.fault.ms = int_argument(r.id, words[3], "fault duration (ms)", 0, 600'000);
+    } else if (words[2] == "refuse") {
+      if (words.size() != 4) malformed(r.id, "fault refuse takes one value (N, the action to refuse)");
+      r.fault.kind = Fault::Kind::kRefuse;
+      r.fault.actions = int_argument(r.id, words[3], "fault refuse action count", 1, 1'000'000);
     } else {
-      malformed(r.id, "unknown fault " + quote(words[2]) + ": expected drop, stall MS or mute MS");
+      malformed(r.id, "unknown fault " + quote(words[2]) + ": expected drop, stall MS, mute MS or refuse N");
     }
   } else {
     throw ProtocolError(ErrorCode::kUnknownCommand, r.id,

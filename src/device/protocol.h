@@ -49,9 +49,10 @@ enum class Command { kHello, kPing, kStatus, kCapture, kVent, kAction, kFault, k
 
 // Test hooks of the emulator (PROTOCOL.md, "Faults").
 struct Fault {
-  enum class Kind { kDrop, kStall, kMute };
+  enum class Kind { kDrop, kStall, kMute, kRefuse };
   Kind kind = Kind::kDrop;
-  int ms = 0;  // kStall, kMute
+  int ms = 0;       // kStall, kMute
+  int actions = 0;  // kRefuse: the action this many from now is refused
 };
 
 struct Request {
