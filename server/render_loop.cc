@@ -67,10 +67,14 @@ Eigen::MatrixXd predicted_at_rest_points(const Mesh& mesh, const Eigen::Matrix3X
   return frame_at_rest_points(mesh, rasterize_top_view(mesh, x, session_grid(g)), frame_grid(g));
 }
 
+// A render job's steps: the capture at rest, the actions, the capture.
+// How many actions it carried out.
+int actions_done(const v1::Job& job) { return std::max(0, job.steps_done() - 1); }
+
 // A job the device failed at one of the plan's actions after carrying out
-// at least one (not at the capture, and not cancelled or interrupted).
+// at least one (not at a capture, and not cancelled or interrupted).
 bool refused_part_way(const v1::Job& job, size_t actions) {
-  return job.state() == v1::JOB_STATE_FAILED && job.steps_done() > 0 && size_t(job.steps_done()) < actions;
+  return job.state() == v1::JOB_STATE_FAILED && actions_done(job) > 0 && size_t(actions_done(job)) < actions;
 }
 
 bool learns_targets(v1::RenderCorrection c) {
@@ -206,12 +210,16 @@ class RenderRun {
     return simulator.state();
   }
 
-  // Submits `steps` and a capture as one device job; waits for it to end.
+  // Submits one device job: a capture at rest (a job starts vented), the
+  // steps, a capture; waits for it to end.
   v1::Job run_on_device(int iteration, const std::vector<Action>& steps, const std::string& which) {
     v1::Plan with_capture;
+    const std::string name = setup_.name + " iteration " + std::to_string(iteration) + which;
+    v1::Step* rest = with_capture.add_steps();
+    rest->mutable_capture();
+    rest->set_label(name + " at rest");
     for (const Action& a : steps) action_to_proto(a, with_capture.add_steps());
     with_capture.set_planner(setup_.planner);
-    const std::string name = setup_.name + " iteration " + std::to_string(iteration) + which;
     v1::Step* capture = with_capture.add_steps();
     capture->mutable_capture();
     capture->set_label(name);
@@ -258,9 +266,9 @@ class RenderRun {
       // the correction works on what it did make.
       it.set_refusal(job.error());
       it.set_refused_job_id(job.id());
-      steps.resize(size_t(job.steps_done()));
-      log_event("render_step_refused", {{"job", job.id()}, {"iteration", i}, {"step", job.steps_done()}});
-      progress(i, 0.5, "the device refused step " + std::to_string(job.steps_done()) + "; running the " +
+      steps.resize(size_t(actions_done(job)));
+      log_event("render_step_refused", {{"job", job.id()}, {"iteration", i}, {"step", actions_done(job)}});
+      progress(i, 0.5, "the device refused step " + std::to_string(actions_done(job)) + "; running the " +
                            std::to_string(steps.size()) + " steps before it");
       predicted_state = predicted_after(i, steps);
       job = run_on_device(i, steps, " (first " + std::to_string(steps.size()) + " steps)");
@@ -268,19 +276,20 @@ class RenderRun {
     it.set_steps_run(int(steps.size()));
     it.set_device_seconds(seconds_since(device_start));
     it.set_job_id(job.id());
-    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() == 0) {
+    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2) {
       const bool cancelled = job.state() == v1::JOB_STATE_CANCELLED && hooks_.cancelled();
       throw ServiceError(cancelled ? StatusCode::CANCELLED : StatusCode::ABORTED,
                          "render iteration " + std::to_string(i) + ": device job " + std::to_string(job.id()) +
                              " ended " + v1::JobState_Name(job.state()) +
                              (job.error().empty() ? std::string() : ": " + job.error()));
     }
+    *it.mutable_rest_capture() = job.captures(0);
     *it.mutable_capture() = job.captures(job.captures_size() - 1);
 
     const Eigen::MatrixXd frame = frame_heights(it.capture());
     if (fits_model(setup_.correction)) fit_model(i, steps, frame, it);
     const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame, frame_grid(it.capture().grid()));
-    const Eigen::MatrixXd measured = calibrated(i, seen, it.mutable_camera());
+    const Eigen::MatrixXd measured = calibrated(i, seen, it.rest_capture(), it.mutable_camera());
     const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, predicted_state.x, it.capture().grid());
     it.set_point_rows(mesh_.point_rows()), it.set_point_cols(mesh_.point_cols());
     add_heights(measured, it.mutable_measured_heights_mm());
@@ -316,8 +325,9 @@ class RenderRun {
   }
 
   // The capture with the camera's plane taken out: the fitted sensor_tilt
-  // where the model is fitted, else the plane fitted on the clamped edge.
-  Eigen::MatrixXd calibrated(int i, const Eigen::MatrixXd& seen, v1::CameraPlane* out) {
+  // where the model is fitted, else the plane fitted on the clamped edge in
+  // the capture at rest (a shaped membrane can bulge over its edge).
+  Eigen::MatrixXd calibrated(int i, const Eigen::MatrixXd& seen, const v1::CaptureFrame& rest, v1::CameraPlane* out) {
     if (setup_.keep_camera_plane) {
       camera_to_proto({}, "none", out);
       return seen;
@@ -330,11 +340,12 @@ class RenderRun {
     }
     CameraPlane plane;
     try {
-      plane = fit_camera_plane(mesh_, seen);
+      plane = fit_camera_plane(mesh_, frame_at_rest_points(mesh_, frame_heights(rest), frame_grid(rest.grid())));
     } catch (const std::invalid_argument& e) {
-      throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
+      throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": the capture at rest: " +
+                                                  e.what());
     }
-    camera_to_proto(plane, "clamped edge", out);
+    camera_to_proto(plane, "clamped edge at rest", out);
     return without_camera_plane(mesh_, seen, plane);
   }
 

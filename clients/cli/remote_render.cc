@@ -36,7 +36,8 @@ constexpr const char* kRenderUsage =
     "                        none (the open-loop plan again, a baseline)\n"
     "  --gain G              of the target correction, (0, 2] (default 1.5)\n"
     "  --keep-camera-plane   compare the captures as they come (default: the camera's tilt\n"
-    "                        and offset are fitted on the clamped edge, or with the model,\n"
+    "                        and offset are fitted on the clamped edge in a capture at rest\n"
+    "                        before each run, or with the model,\n"
     "                        and taken out)\n"
     "  --name NAME           the device jobs' names (\"NAME iteration I\", default render)\n"
     "  --out DIR             DIR/goal.csv, DIR/result.json and per iteration DIR/iteration-I/\n"
@@ -114,6 +115,7 @@ void write_iteration(const fs::path& out, const v1::RenderIteration& it) {
   if (!it.refusal().empty()) doc["refusal"] = it.refusal(), doc["refused_job_id"] = it.refused_job_id();
   std::ofstream(dir / "plan.json") << doc.dump(1) << "\n";
   write_frame_csv(dir / "capture.csv", frame_heights(it.capture()));
+  if (it.rest_capture().heights_mm_size() > 0) write_frame_csv(dir / "rest.csv", frame_heights(it.rest_capture()));
   write_frame_csv(dir / "measured.csv", points(it.measured_heights_mm(), it.point_rows(), it.point_cols()));
   write_frame_csv(dir / "predicted.csv", points(it.predicted_heights_mm(), it.point_rows(), it.point_cols()));
   write_frame_csv(dir / "targets.csv", points(it.target_heights_mm(), it.point_rows(), it.point_cols()));
