@@ -301,7 +301,7 @@ class RenderRun {
     } catch (const std::invalid_argument& e) {
       throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
     }
-    it.set_correction(correct(measured, it));
+    it.set_correction(correct(whole_plan_outcome(measured, predicted, planned, it), it));
     return it;
   }
 
@@ -349,8 +349,18 @@ class RenderRun {
     return without_camera_plane(mesh_, seen, plane);
   }
 
+  // What the whole plan would have made on the device, for the targets
+  // correction: the capture itself, or after a refusal the model's whole-plan
+  // surface moved by the device's departure from the model on the steps it
+  // did run (the unrun steps are not the device's answer to the targets).
+  Eigen::MatrixXd whole_plan_outcome(const Eigen::MatrixXd& measured, const Eigen::MatrixXd& predicted,
+                                     const PlanResult& planned, const v1::RenderIteration& it) const {
+    if (it.refusal().empty()) return measured;
+    return predicted_at_rest_points(mesh_, planned.final_state.x, it.capture().grid()) + (measured - predicted);
+  }
+
   // The next iteration's targets; what changed, for people.
-  std::string correct(const Eigen::MatrixXd& measured, const v1::RenderIteration& it) {
+  std::string correct(const Eigen::MatrixXd& outcome, const v1::RenderIteration& it) {
     if (setup_.correction == v1::RENDER_CORRECTION_NONE) return "none (open loop: the same targets again)";
     std::ostringstream s;
     s.precision(3);
@@ -360,11 +370,13 @@ class RenderRun {
       for (const auto& p : it.model().parameters()) s << " " << p.name() << " " << p.value();
     }
     if (learns_targets(setup_.correction)) {
-      const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, measured, setup_.gain);
+      const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, outcome, setup_.gain);
       const Eigen::ArrayXXd change = (next - targets_).array().abs();
       targets_ = next;
       if (fits_model(setup_.correction)) s << "; ";
-      s << "targets += " << setup_.gain << " x (goal - measured): mean |change| " << change.mean() << " mm, max "
+      s << "targets += " << setup_.gain << " x (goal - "
+        << (it.refusal().empty() ? "measured" : "whole plan's prediction moved by the measured misfit")
+        << "): mean |change| " << change.mean() << " mm, max "
         << change.maxCoeff() << " mm";
     }
     return s.str();
