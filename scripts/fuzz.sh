@@ -28,7 +28,7 @@ seed() {  # TARGET DIR: fills the seed corpus
   mkdir -p "$dir"
   case "$target" in
     fuzz_protocol)
-      for line in "7 hello" "8 jam 0 3" "9 set_pressure 301" "3 fault stall 500" \
+      for line in "7 hello" "8 jam 0 3" "9 set_pressure 301" "3 fault stall 500" "5 fault refuse 2" \
         "ok 1 protocol=1 rows=3 cols=4 cell_mm=38 max_pressure_pa=3450 grid=77,58,0,0,2,2" \
         "err 4 unsafe unsafe pressure 9 kPa" "pressure_pa=301 jammed=000100000000 pinned=00000000000000000000" \
         "frame 3 2 0 0 2 2 0,1,nan,2.5,3,4"; do
