@@ -246,6 +246,22 @@ class RenderRun {
     }
   }
 
+  // The device could not complete a step its model settles (a device is
+  // not the model): the iteration is run again up to the step before, so it
+  // ends where the device stood and the correction works on what it made.
+  // Shortens `steps` and moves `predicted` to match; the new job.
+  v1::Job rerun_before_refusal(int i, const v1::Job& refused, std::vector<Action>& steps, DeviceState& predicted,
+                               v1::RenderIteration& it) {
+    it.set_refusal(refused.error());
+    it.set_refused_job_id(refused.id());
+    steps.resize(size_t(actions_done(refused)));
+    log_event("render_step_refused", {{"job", refused.id()}, {"iteration", i}, {"step", actions_done(refused)}});
+    progress(i, 0.5, "the device refused step " + std::to_string(steps.size()) + "; running the " +
+                         std::to_string(steps.size()) + " steps before it");
+    predicted = predicted_after(i, steps);
+    return run_on_device(i, steps, " (first " + std::to_string(steps.size()) + " steps)");
+  }
+
   v1::RenderIteration iterate(int i) {
     v1::RenderIteration it;
     it.set_iteration(i);
@@ -260,19 +276,7 @@ class RenderRun {
     std::vector<Action> steps = planned.steps;
     DeviceState predicted_state = planned.final_state;
     v1::Job job = run_on_device(i, steps, "");
-    if (refused_part_way(job, steps.size())) {
-      // The device could not complete a step its model settles (a device
-      // is not the model): this iteration ends where the device stood, and
-      // the correction works on what it did make.
-      it.set_refusal(job.error());
-      it.set_refused_job_id(job.id());
-      steps.resize(size_t(actions_done(job)));
-      log_event("render_step_refused", {{"job", job.id()}, {"iteration", i}, {"step", actions_done(job)}});
-      progress(i, 0.5, "the device refused step " + std::to_string(actions_done(job)) + "; running the " +
-                           std::to_string(steps.size()) + " steps before it");
-      predicted_state = predicted_after(i, steps);
-      job = run_on_device(i, steps, " (first " + std::to_string(steps.size()) + " steps)");
-    }
+    if (refused_part_way(job, steps.size())) job = rerun_before_refusal(i, job, steps, predicted_state, it);
     it.set_steps_run(int(steps.size()));
     it.set_device_seconds(seconds_since(device_start));
     it.set_job_id(job.id());

@@ -48,10 +48,14 @@ bool blank(std::string_view line) { return line.find_first_not_of(" \t") == std:
 
 constexpr std::size_t kMaxActionLog = 100'000;
 
+// The request as sent, without its id: "set_pressure 900".
+std::string command_text(const protocol::Request& r) {
+  const std::string line = protocol::format_request(r);
+  return line.substr(line.find(' ') + 1);
+}
+
 std::string overtaken_message(const protocol::Request& r, const std::string& why) {
-  std::string command = protocol::format_request(r);
-  command = command.substr(command.find(' ') + 1);
-  return "\"" + command + "\" not carried out: the device vented (" + why + ")";
+  return "\"" + command_text(r) + "\" not carried out: the device vented (" + why + ")";
 }
 
 }  // namespace
@@ -277,9 +281,8 @@ struct EmulatorServer::Impl {
 
   void carry_out(const DeviceCommand& command) {
     if (command.refused) {
-      const std::string action = protocol::format_request(command.request);
       last_reply = protocol::format_err(command.request.id, protocol::ErrorCode::kFailed,
-                                        action.substr(action.find(' ') + 1) +
+                                        command_text(command.request) +
                                             ": refused (fault refuse); the state is as before it");
       return;
     }
