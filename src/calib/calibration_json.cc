@@ -21,6 +21,7 @@ nlohmann::json candidate_json(const CandidateFit& c) {
   if (c.screened_out) j["screening"] = c.screening_note;
   if (!c.scan_note.empty()) j["scan"] = c.scan_note;
   if (!c.recheck_note.empty()) j["recheck"] = c.recheck_note;
+  if (!c.probe_note.empty()) j["probe"] = c.probe_note;
   if (!c.starts_tried.empty()) {
     nlohmann::json starts = nlohmann::json::array();
     for (const auto& t : c.starts_tried)

@@ -12,8 +12,9 @@ namespace hj {
 
 // Refits the candidates the screening let through, the most promising
 // first, so that one that cannot come near the best refitted one need not
-// be refitted (refit_cutoff). fits.front() is the best significant refit;
-// a candidate the model cannot replay is said so in out.skipped.
+// be refitted (refit_cutoff, refit_cutoff_explained). fits.front() is the
+// best significant refit; a candidate the model cannot replay is said so in
+// out.skipped.
 void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits);
 
 }  // namespace hj

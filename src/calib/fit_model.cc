@@ -43,31 +43,6 @@ void refine_on_bare_captures(const Dataset& dataset, const std::vector<FitParame
   }
 }
 
-// The joint fit may converge beside a clearly better basin
-// (optimum_probe.h): fit again from the best probed point while one is.
-// Only a converged fit: one the iteration cap cut short is still on its way.
-void probe_and_refit(const Dataset& dataset, const std::vector<FitParameter>& parameters, const FitOptions& options,
-                     const FitProgress& progress, FitReport& out) {
-  for (int round = 0; round < options.probe_rounds && out.joint.converged; ++round) {
-    if (progress) progress("probing the optimum", 0, 1, "");
-    const OptimumProbe probe = probe_optimum(dataset, out.joint, options.least_squares.replay, options.probe);
-    if (progress) progress("probing the optimum", 1, 1, probe.moved ? probe.note : "no better point");
-    if (!probe.moved) return;
-    const std::string stage = "least squares from the probe";
-    LeastSquaresResult next = fit_least_squares(dataset, probe.best, parameters, options.least_squares,
-                                                [&](int iteration, int max_iterations, double rmse) {
-                                                  if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
-                                                });
-    if (!(next.sum_sq_mm2 < out.joint.sum_sq_mm2)) return;
-    char text[320];
-    std::snprintf(text, sizeof text,
-                  "the least squares converged beside a better basin and was restarted from %s: RMSE %.4f -> %.4f mm",
-                  probe.note.c_str(), out.joint.rmse_mm, next.rmse_mm);
-    out.probe_notes.push_back(text);
-    out.joint = std::move(next);
-  }
-}
-
 }  // namespace
 
 std::string rmse_detail(double rmse_mm) {
@@ -81,6 +56,30 @@ std::optional<double> rmse_of_detail(const std::string& detail) {
   char unit[4] = {};
   if (std::sscanf(detail.c_str(), "RMSE %lf %3s", &rmse, unit) == 2 && std::string(unit) == "mm") return rmse;
   return std::nullopt;
+}
+
+LeastSquaresResult probe_and_refit(const Dataset& dataset, const std::vector<FitParameter>& parameters,
+                                   const FitOptions& options, const FitProgress& progress, LeastSquaresResult fit,
+                                   std::vector<std::string>& notes) {
+  for (int round = 0; round < options.probe_rounds && fit.converged; ++round) {
+    if (progress) progress("probing the optimum", 0, 1, "");
+    const OptimumProbe probe = probe_optimum(dataset, fit, options.least_squares.replay, options.probe);
+    if (progress) progress("probing the optimum", 1, 1, probe.moved ? probe.note : "no better point");
+    if (!probe.moved) break;
+    const std::string stage = "least squares from the probe";
+    LeastSquaresResult next = fit_least_squares(dataset, probe.best, parameters, options.least_squares,
+                                                [&](int iteration, int max_iterations, double rmse) {
+                                                  if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
+                                                });
+    if (!(next.sum_sq_mm2 < fit.sum_sq_mm2)) break;
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "the least squares converged beside a better basin and was restarted from %s: RMSE %.4f -> %.4f mm",
+                  probe.note.c_str(), fit.rmse_mm, next.rmse_mm);
+    notes.push_back(text);
+    fit = std::move(next);
+  }
+  return fit;
 }
 
 FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,
@@ -120,7 +119,7 @@ FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std:
                                 [&](int iteration, int max_iterations, double rmse) {
                                   if (progress) progress("least squares", iteration, max_iterations, rmse_detail(rmse));
                                 });
-  probe_and_refit(dataset, parameters, options, progress, out);
+  out.joint = probe_and_refit(dataset, parameters, options, progress, std::move(out.joint), out.probe_notes);
   if (options.profile_loose)
     profile_loose_parameters(dataset, parameters, options.least_squares, options.profile, out.joint,
                              [&](const std::string& name, int evaluations, const std::string& detail) {

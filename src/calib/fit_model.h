@@ -62,6 +62,13 @@ using FitProgress = std::function<void(const std::string& stage, int done, int t
 std::string rmse_detail(double rmse_mm);
 std::optional<double> rmse_of_detail(const std::string& detail);
 
+// A converged least-squares fit may sit beside a clearly better basin
+// (optimum_probe.h): fits again from the best probed point while one is, up
+// to options.probe_rounds times, and says where from in `notes`.
+LeastSquaresResult probe_and_refit(const Dataset& dataset, const std::vector<FitParameter>& parameters,
+                                   const FitOptions& options, const FitProgress& progress, LeastSquaresResult fit,
+                                   std::vector<std::string>& notes);
+
 // Fits the baseline plus `effects` (switched on with their defaults unless
 // `start` has values for them).
 FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std::vector<std::string>& effects,

@@ -20,6 +20,7 @@ std::string candidate_note(const CandidateFit& c) {
   std::string note = c.significant ? "significant" : c.screened_out ? "screened out (predicted): " + c.screening_note : "";
   if (!c.scan_note.empty()) note += (note.empty() ? "" : "; ") + std::string("started at ") + c.scan_note;
   if (!c.recheck_note.empty()) note += (note.empty() ? "" : "; ") + c.recheck_note;
+  if (!c.probe_note.empty()) note += (note.empty() ? "" : "; ") + c.probe_note;
   return note;
 }
 
