@@ -65,8 +65,10 @@ TEST(CalibDiagnoseSynth, FindsTheCameraTiltAndFitsIt) {
     EXPECT_EQ(result.final_params.effect_parameters.at("sensor_tilt").at(name + std::string("sensor_tilt.").size()),
               e->value);
   }
-  // The chosen fit converged before the next round was judged against it.
-  EXPECT_TRUE(result.notes.empty()) << ::testing::PrintToString(result.notes);
+  // The chosen fit converged before the next round was judged against it,
+  // or no next round was needed.
+  for (const std::string& note : result.notes)
+    EXPECT_EQ(note.find("did not converge"), std::string::npos) << note;
   // With the effect the fit is down at the camera's noise floor.
   EXPECT_GT(result.baseline.joint.rmse_mm, 1.3 * result.noise_floor_mm);
   EXPECT_LT(result.ladder.back().rmse_mm, 1.05 * result.noise_floor_mm);

@@ -307,6 +307,20 @@ std::vector<std::string> effects_for_next_round(const std::vector<CandidateFit>&
   return next;
 }
 
+// The chosen model's residuals pass the chi-square test against the
+// sensor's noise itself (not only the floor's tolerance): no further effect
+// can lower the held-out error by a real margin, so no round is run for one.
+bool leaves_only_noise(Selection& s) {
+  const GoodnessOfFit g = goodness_of_fit(s.current, s.out.noise_floor_mm, s.options.goodness);
+  if (g.p_value < s.options.goodness.alpha) return false;
+  char note[200];
+  std::snprintf(note, sizeof note,
+                "no further round: with %s the residuals are the sensor's noise (chi-square p = %.3g)",
+                s.chosen.back().c_str(), g.p_value);
+  s.out.notes.push_back(note);
+  return true;
+}
+
 }  // namespace
 
 double bic(const LeastSquaresResult& fit) {
@@ -345,6 +359,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
     s.current = best.fit;
     s.current_heldout = best.heldout_rmse_mm;
     out.ladder.push_back({"+ " + best.added, best.fit.rmse_mm, best.heldout_rmse_mm});
+    if (leaves_only_noise(s)) break;
   }
   out.verdict = s.chosen;
   out.final_params = s.current.params;
