@@ -48,6 +48,7 @@ void BM_SessionResiduals(benchmark::State& state, const std::string& name) {
 }
 BENCHMARK_CAPTURE(BM_SessionResiduals, unjammed_sweep, std::string("unjammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SessionResiduals, jammed_sweep, std::string("jammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SessionResiduals, paper_sequence, std::string("paper-sequence"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The levelling crossing with its 95 % interval (the mass interval of a
 // fit), on the demo's unjammed sweep.
