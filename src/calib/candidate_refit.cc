@@ -13,8 +13,10 @@ namespace hj {
 
 bool is_significant(const CandidateFit& c, const LeastSquaresResult& current, double reference_heldout_mm,
                     const DiagnoseOptions& options) {
+  const bool fits_better = c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm ||
+                           c.delta_bic < options.strong_delta_bic;
   return c.heldout_rmse_mm <= (1.0 - options.min_heldout_gain) * reference_heldout_mm &&
-         c.delta_bic < options.max_delta_bic && c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm;
+         c.delta_bic < options.max_delta_bic && fits_better;
 }
 
 namespace {

@@ -169,7 +169,8 @@ std::string diagnose_report_html(const std::string& dataset_name, const Diagnosi
   for (const auto& n : loose_notes(base)) html.paragraph(n);
   html.paragraph("Significant = the leave-one-session-out RMSE falls by at least " +
                  num(100 * options.min_heldout_gain, "%.0f") + " %, the in-sample RMSE by at least " +
-                 num(100 * options.min_fit_gain, "%.1f") + " % and delta BIC < " +
+                 num(100 * options.min_fit_gain, "%.1f") + " % (or delta BIC < " +
+                 num(options.strong_delta_bic, "%.0f") + ") and delta BIC < " +
                  num(options.max_delta_bic, "%.0f") + ". Run time " + num(run_time.wall_s, "%.1f") + " s" +
                  (run_time.cpu_s ? " (CPU " + num(*run_time.cpu_s, "%.1f") + " s)" : "") + ".");
   return html.html();
