@@ -94,7 +94,8 @@ bool is_cell_effect(const std::string& effect) {
 }
 
 CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const std::vector<FitParameter>& parameters,
-                        const std::string& effect, const LeastSquaresResult& current, const LeastSquaresOptions& fit) {
+                        const std::string& effect, const LeastSquaresResult& current, const LeastSquaresOptions& fit,
+                        double refine_below) {
   const ReplayOptions& replay = fit.replay;
   // An orthonormal basis of the current Jacobian's columns (none if the fit has none).
   Eigen::MatrixXd basis;
@@ -148,7 +149,19 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
   LeastSquaresOptions short_fit = fit;
   short_fit.max_iterations = 4;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < ranked.size() && k < kCellsRefined; ++k) {
+  const size_t refined = ranked.front().predicted < refine_below ? kCellsRefined : 0;
+  if (refined == 0) {
+    const CellScore& cell = ranked.front();
+    out.best = start;
+    out.best.effect_parameters[effect]["row"] = cell.row;
+    out.best.effect_parameters[effect]["col"] = cell.col;
+    for (const auto& p : parameters)
+      if (!p.surface && p.effect == effect) set_parameter_value(out.best, p, cell.value);
+    out.row = cell.row;
+    out.col = cell.col;
+    best_cost = cell.predicted;
+  }
+  for (size_t k = 0; k < ranked.size() && k < refined; ++k) {
     const CellScore& cell = ranked[k];
     if (!std::isfinite(cell.predicted)) break;
     // From the predicted value and from the probe on its side: where the
@@ -185,9 +198,15 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
       std::snprintf(text, sizeof text, ", %s %.3g", p.spec.name.c_str(), parameter_value(out.best, p));
       values += text;
     }
-  std::snprintf(text, sizeof text, "%s at cell [%d, %d]%s (best of %zu cells fitted; sum of squares %+.1f %%)",
-                effect.c_str(), out.row, out.col, values.c_str(), std::min(ranked.size(), kCellsRefined),
-                -100.0 * (1.0 - best_cost / current.sum_sq_mm2));
+  if (refined > 0)
+    std::snprintf(text, sizeof text, "%s at cell [%d, %d]%s (best of %zu cells fitted; sum of squares %+.1f %%)",
+                  effect.c_str(), out.row, out.col, values.c_str(), std::min(ranked.size(), refined),
+                  -100.0 * (1.0 - best_cost / current.sum_sq_mm2));
+  else
+    std::snprintf(text, sizeof text,
+                  "%s at cell [%d, %d]%s (predicted, not fitted: sum of squares %+.1f %%, far above another "
+                  "effect's scan)",
+                  effect.c_str(), out.row, out.col, values.c_str(), -100.0 * (1.0 - best_cost / current.sum_sq_mm2));
   out.note = text;
   return out;
 }

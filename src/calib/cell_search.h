@@ -15,6 +15,7 @@
 // gives the cell and the start of the scan and refit.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -37,8 +38,12 @@ struct CellSearch {
 // @param start  the current model with `effect` switched on
 // @param current  the current model's fit (its Jacobian and sum of squares)
 // @param fit  the least-squares options of the short fits (and their replays)
+// @param refine_below  the short fits run only if the best cell's predicted
+//   sum of squares is below this (mm^2): where another effect's scan already
+//   does far better, the best cell at its predicted value is start enough
 // @throws std::runtime_error if no cell and probe replays, or no best cell's fit
 CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const std::vector<FitParameter>& parameters,
-                        const std::string& effect, const LeastSquaresResult& current, const LeastSquaresOptions& fit);
+                        const std::string& effect, const LeastSquaresResult& current, const LeastSquaresOptions& fit,
+                        double refine_below = std::numeric_limits<double>::infinity());
 
 }  // namespace hj

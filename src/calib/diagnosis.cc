@@ -184,8 +184,10 @@ void fit_baseline(const Dataset& dataset, const ModelParams& start, const Diagno
 }
 
 // The candidate that adds `effect` to the chosen ones, its start moved by
-// the scan (effect_scan.h) where that found a better one.
-CandidateFit scanned_candidate(const Selection& s, const std::string& effect) {
+// the scan (effect_scan.h) where that found a better one; a cell effect's
+// search fits its best cells only where it predicts a sum of squares below
+// `refine_below` (cell_search.h).
+CandidateFit scanned_candidate(const Selection& s, const std::string& effect, double refine_below) {
   CandidateFit c;
   c.effects = s.chosen;
   c.effects.push_back(effect);
@@ -197,7 +199,8 @@ CandidateFit scanned_candidate(const Selection& s, const std::string& effect) {
     ModelParams start = with_effects(s.current.params, c.effects);
     if (is_cell_effect(effect)) {
       // Which cell: a search no local fit can make (cell_search.h).
-      CellSearch cell = search_cells(s.dataset, start, parameters, effect, s.current, s.options.fit.least_squares);
+      CellSearch cell =
+          search_cells(s.dataset, start, parameters, effect, s.current, s.options.fit.least_squares, refine_below);
       start = cell.best;
       c.scanned_start = start;
       c.scan_note = cell.note;
@@ -219,11 +222,22 @@ CandidateFit scanned_candidate(const Selection& s, const std::string& effect) {
 }
 
 // Scans and screens each remaining effect: those the screening keeps out go
-// to `fits` with their predicted figures, the others to `to_refit`.
-void scan_and_screen(const Selection& s, const std::vector<std::string>& remaining, std::vector<CandidateFit>& fits,
+// to `fits` with their predicted figures, the others to `to_refit`. The
+// cell effects go last: their search's short fits, the dearest part of a
+// scan, are paid for only where no other effect's scan already reached a
+// sum of squares refit_cutoff^2 times lower (a strong bending: -80 % against
+// a cell's -4 %, 160 of 720 CPU s in two rounds).
+void scan_and_screen(const Selection& s, std::vector<std::string> remaining, std::vector<CandidateFit>& fits,
                      std::vector<CandidateFit>& to_refit) {
+  std::stable_partition(remaining.begin(), remaining.end(), [](const std::string& e) { return !is_cell_effect(e); });
+  double best_scan_sum_sq = std::numeric_limits<double>::infinity();
   for (const auto& effect : remaining) {
-    CandidateFit c = scanned_candidate(s, effect);
+    const double refine_below = s.options.refit_cutoff > 0.0
+                                    ? s.options.refit_cutoff * s.options.refit_cutoff * best_scan_sum_sq
+                                    : std::numeric_limits<double>::infinity();
+    CandidateFit c = scanned_candidate(s, effect, refine_below);
+    if (std::isfinite(c.scan_rmse_mm))
+      best_scan_sum_sq = std::min(best_scan_sum_sq, c.scan_rmse_mm * c.scan_rmse_mm * s.current.residual_count);
     if (s.options.screening) {
       const auto parameters = fit_parameters(c.effects);
       if (s.progress) s.progress("screening " + effect, 0, 1, "");
