@@ -151,8 +151,11 @@ def row(work, case):
     worst = diag.get("worst_cells") or []
     if worst and explained is False:
         explained_text += " (worst cell [%d, %d])" % tuple(worst[0])
-    return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal),
-            ("**%s**" if correct else "%s (WRONG)") % verdict + (" (the effect is within the noise)" if hidden else ""), "<br>".join(ranking), "<br>".join(fitted) or "-",
+    verdict_text = ("**%s**" if correct else "%s (WRONG)") % verdict
+    if hidden:
+        verdict_text += " (the effect is within the noise)"
+    return [case, effects, true_text, "%.3f (%.2f)" % (rmse, signal), verdict_text, "<br>".join(ranking),
+            "<br>".join(fitted) or "-",
             surface_text, rmse_text, explained_text, "%.0f" % diag["seconds"], "%.0f" % diag["cpu_seconds"],
             time_by_stage(os.path.join(base, "diagnose.log"))]
 

@@ -47,9 +47,9 @@ double expected_rmse(const CandidateFit& c) {
 
 // A candidate not refitted because the RMSE its refit is expected to reach
 // is more than refit_cutoff (refit_cutoff_explained once one explains the
-// data) times the held-out RMSE of a significant one
-// already refitted in this round: it keeps the expected figures and a
-// note, as a screened-out candidate does.
+// data) times the held-out RMSE of a significant one already refitted in
+// this round: it keeps the expected figures and a note, as a screened-out
+// candidate does.
 void outrun(CandidateFit& c, const LeastSquaresResult& current, double best_heldout, const std::string& best) {
   const double expected = expected_rmse(c);
   c.fit = LeastSquaresResult{};
@@ -147,10 +147,8 @@ void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::ve
   double best_heldout = std::numeric_limits<double>::infinity();
   s.round_explained = false;
   for (CandidateFit& c : to_refit) {
-    const double cutoff = s.options.refit_cutoff <= 0.0 ? 0.0
-                          : s.round_explained       ? s.options.refit_cutoff_explained
-                                                    : s.options.refit_cutoff;
-    if (s.options.screening && cutoff > 0.0 && expected_rmse(c) > cutoff * best_heldout) {
+    const double cutoff = s.round_explained ? s.options.refit_cutoff_explained : s.options.refit_cutoff;
+    if (s.options.screening && s.options.refit_cutoff > 0.0 && expected_rmse(c) > cutoff * best_heldout) {
       outrun(c, s.current, best_heldout, fits.front().added);
       fits.push_back(std::move(c));
       continue;

@@ -71,6 +71,17 @@ void predict_along_probe(const Eigen::VectorXd& r0_off, const Eigen::VectorXd& r
   point.predicted_value = geometric ? spec.default_value * std::exp(t * step) : spec.default_value + t * step;
 }
 
+// `start` with `effect` in cell (row, col) and its fitted parameters at `value`.
+ModelParams in_cell(const ModelParams& start, const std::vector<FitParameter>& parameters, const std::string& effect,
+                    int row, int col, double value) {
+  ModelParams m = start;
+  m.effect_parameters[effect]["row"] = row;
+  m.effect_parameters[effect]["col"] = col;
+  for (const auto& p : parameters)
+    if (!p.surface && p.effect == effect) set_parameter_value(m, p, value);
+  return m;
+}
+
 // Cells best first by the lowest sum of squares any of their probes predicts.
 std::vector<CellScore> rank_cells(const std::vector<Point>& points) {
   std::map<std::pair<int, int>, CellScore> by_cell;
@@ -152,11 +163,7 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
   const size_t refined = ranked.front().predicted < refine_below ? kCellsRefined : 0;
   if (refined == 0) {
     const CellScore& cell = ranked.front();
-    out.best = start;
-    out.best.effect_parameters[effect]["row"] = cell.row;
-    out.best.effect_parameters[effect]["col"] = cell.col;
-    for (const auto& p : parameters)
-      if (!p.surface && p.effect == effect) set_parameter_value(out.best, p, cell.value);
+    out.best = in_cell(start, parameters, effect, cell.row, cell.col, cell.value);
     out.row = cell.row;
     out.col = cell.col;
     best_cost = cell.predicted;
@@ -167,13 +174,9 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
     // From the predicted value and from the probe on its side: where the
     // current fit is far from the truth the linear prediction falls short.
     for (double value : {cell.value, cell.probe->value}) {
-      ModelParams m = start;
-      m.effect_parameters[effect]["row"] = cell.row;
-      m.effect_parameters[effect]["col"] = cell.col;
-      for (const auto& p : parameters)
-        if (!p.surface && p.effect == effect) set_parameter_value(m, p, value);
       try {
-        LeastSquaresResult r = fit_least_squares(dataset, m, parameters, short_fit);
+        LeastSquaresResult r = fit_least_squares(
+            dataset, in_cell(start, parameters, effect, cell.row, cell.col, value), parameters, short_fit);
         out.replays += r.evaluations + r.jacobians * r.free_parameters;
         if (r.sum_sq_mm2 < best_cost) {
           best_cost = r.sum_sq_mm2;

@@ -324,7 +324,7 @@ std::vector<std::string> effects_for_next_round(const std::vector<CandidateFit>&
 // The chosen model's residuals pass the chi-square test against the
 // sensor's noise itself (not only the floor's tolerance): no further effect
 // can lower the held-out error by a real margin, so no round is run for one.
-bool leaves_only_noise(Selection& s) {
+bool leaves_only_noise(const Selection& s) {
   const GoodnessOfFit g = goodness_of_fit(s.current, s.out.noise_floor_mm, s.options.goodness);
   if (g.p_value < s.options.goodness.alpha) return false;
   char note[200];
