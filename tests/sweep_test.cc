@@ -133,7 +133,7 @@ TEST(SweepCli, WritesTheTableTheFitAndBothFigures) {
   const std::string table = read_text(out / "sweep.csv");
   EXPECT_EQ(table.substr(0, table.find('\n')),
             "goal,rows,cols,cells,correlation,laplace_mean_a0,laplace_mean_a1_8,laplace_mean_a1_4,laplace_mean_a1_2,"
-            "laplace_mean_a1,steps,refused,relief_mm,seconds,status,detail");
+            "laplace_mean_a1,steps,refused,relief_mm,seconds,settle_seconds,refused_seconds,status,detail,note");
   EXPECT_NE(table.find("bump,2,3,6,"), std::string::npos);
   const std::string t2 = read_text(out / "table2.csv");
   EXPECT_EQ(t2.substr(0, t2.find('\n')), "alpha_l,slope,intercept,r2,n,paper_r2");

@@ -29,8 +29,9 @@ constexpr const char* kSweepUsage =
     "                       [--align [--align-pick cost|random]]\n"
     "Plans every GOAL at every array size, the plans in parallel (one thread each),\n"
     "and writes DIR/sweep.csv (goal, rows, cols, cells, correlation, the Laplace\n"
-    "mean of the goal as resampled to the mesh for each alpha_L, steps, seconds,\n"
-    "refused, relief_mm, status, detail), DIR/table2.csv (line fit of correlation\n"
+    "mean of the goal as resampled to the mesh for each alpha_L, steps, refused,\n"
+    "relief_mm, seconds and of them the settles kept and refused, status, detail,\n"
+    "the planner's note), DIR/table2.csv (line fit of correlation\n"
     "against the Laplace mean per alpha_L beside the paper's r^2, also printed),\n"
     "DIR/fig11_correlation_vs_cells.png and DIR/fig13_correlation_vs_laplace.png\n"
     "(at the alpha_L whose fit is best).\n"
@@ -171,7 +172,7 @@ int sweep(const SweepArgs& args) {
     std::ofstream csv(out / "sweep.csv");
     csv << "goal,rows,cols,cells,correlation";
     for (double a : alphas) csv << ",laplace_mean_" << alpha_name(a);
-    csv << ",steps,refused,relief_mm,seconds,status,detail";
+    csv << ",steps,refused,relief_mm,seconds,settle_seconds,refused_seconds,status,detail,note";
     if (args.options.align)
       csv << ",align_shift_x_cells,align_shift_y_cells,align_scale,unaligned_correlation,align_gain,unaligned_seconds,"
              "align_planned";
@@ -183,8 +184,8 @@ int sweep(const SweepArgs& args) {
         csv << ",";
         if (k < r.laplace_mean.size()) csv << r.laplace_mean[k];
       }
-      csv << "," << r.steps << "," << r.refused << "," << r.relief_mm << "," << r.seconds << "," << r.status << ","
-          << csv_field(r.detail);
+      csv << "," << r.steps << "," << r.refused << "," << r.relief_mm << "," << r.seconds << "," << r.settle_seconds
+          << "," << r.refused_seconds << "," << r.status << "," << csv_field(r.detail) << "," << csv_field(r.note);
       if (args.options.align) {
         csv << ",";
         if (r.align) {

@@ -115,6 +115,9 @@ SweepRow run_one(const SweepGoal& goal, ArraySize size, const SweepOptions& opti
     }
     row.steps = int(result.steps.size());
     row.refused = int(result.refused.size());
+    row.settle_seconds = result.settle_seconds;
+    row.refused_seconds = result.refused_seconds;
+    row.note = result.note;
     // Mesh rows run along +y; the goal image's row 0 is its top.
     const Eigen::MatrixXd predicted_image = (point_heights(mesh, result.final_state.x) * 1000.0).colwise().reverse();
     const Correlation corr = correlate_with_goal(scored_goal->z, predicted_image);

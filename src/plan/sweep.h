@@ -69,6 +69,10 @@ struct SweepRow {
   int refused = 0;         // actions the planner refused as dead ends (PlanResult::refused)
   double relief_mm = 0.0;  // the goal's relief on this array
   double seconds = 0.0;
+  // Of seconds: the settles the plan kept and those it refused as dead ends
+  // (PlanResult::settle_seconds, refused_seconds).
+  double settle_seconds = 0.0, refused_seconds = 0.0;
+  std::string note;    // the planner's own account (PlanResult::note), e.g. a portfolio's choice
   std::string status;  // "ok", "undefined" (correlation undefined), "over-budget", "failed"
   std::string detail;  // the error or the reason the correlation is undefined
   std::optional<SweepAlignment> align;  // with SweepOptions::align; correlation is then the aligned goal's

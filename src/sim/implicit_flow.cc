@@ -112,9 +112,9 @@ SettleReport settle_implicit_flow(const ForceModel& model, DeviceState& state, c
       continue;
     }
     state.x += k.scatter(moved);
-    if (options.abandon && options.abandon(state.x)) break;
     f.swap(f_y);
     residual = k.gather(f);
+    if (options.abandon && options.abandon(state.x, max_free_force(f, fixed))) break;
     const double easier = mu * (newton <= 1 ? kShiftDownEasy : newton <= 3 ? kShiftDown : 1.0);
     const double within_cap = mu * largest_move(moved) / (kTargetMoveFraction * max_step);
     mu = std::max({easier, within_cap, kMinShift * spring_k});

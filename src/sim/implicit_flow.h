@@ -30,9 +30,10 @@ struct ImplicitFlowOptions {
   double max_step_fraction = 0.5;      // largest move of a point per step, in h
   // Polled every step; true throws SettleInterrupted (state left mid-way).
   std::function<bool()> interrupted;
-  // Asked of the positions after every accepted step; true ends the flow
-  // there, unconverged (a caller that refuses folded states stops at the first fold).
-  std::function<bool(const Eigen::Matrix3Xd& x)> abandon;
+  // Asked of the positions and the largest |F| on a free point (N) after
+  // every accepted step; true ends the flow there, unconverged (a planner
+  // stops at a dead end, sim/dead_end_watch.h).
+  std::function<bool(const Eigen::Matrix3Xd& x, double residual_n)> abandon;
 
   // Throws std::invalid_argument naming the bad field.
   void validate() const;

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "sim/coarse_start.h"
+#include "sim/dead_end_watch.h"
 #include "sim/effect_registry.h"
 #include "sim/jamming_springs.h"
 #include "sim/levelling_crossing.h"
@@ -36,6 +37,10 @@ Simulator::Simulator(const ArrayGeometry& geometry, const SurfaceParameters& par
   options_.flow_options.validate();
   if (!(options_.refuse_fold_deg >= 90.0 && options_.refuse_fold_deg <= 180.0))
     throw std::invalid_argument("simulator option refuse_fold_deg (degrees) must lie in [90, 180]");
+  if (!(options_.stall_fold_deg >= 90.0 && options_.stall_fold_deg <= options_.refuse_fold_deg))
+    throw std::invalid_argument("simulator option stall_fold_deg (degrees) must lie in [90, refuse_fold_deg]");
+  if (options_.refuse_stall_steps < 0)
+    throw std::invalid_argument("simulator option refuse_stall_steps must be >= 0 (0: no limit)");
   if (options_.fallback_max_steps < 0)
     throw std::invalid_argument("simulator option fallback_max_steps must be >= 0 (0: no explicit fallback)");
   if (options_.max_settle_steps < 0)
@@ -109,7 +114,7 @@ bool Simulator::settle_fast_then_flow(const Eigen::Matrix3Xd& before) {
   SettleReport spent = last_;
   state_.x = before;
   if (flow_then_polish(1, spent)) return true;
-  if (options_.refuse_folded && folded_past_refusal(state_.x)) {
+  if (*flow_dead_end_) {
     // The model's own dynamics lead into a fold: a dead end for a planner.
     dead_end_ = true;
     last_ = spent;
@@ -135,14 +140,21 @@ bool Simulator::polish(const SettleReport& fallback, SettleReport& spent) {
   return last_.converged;
 }
 
-bool Simulator::folded_past_refusal(const Eigen::Matrix3Xd& x) const {
-  return find_mesh_folds(mesh(), x).sharpest_deg > options_.refuse_fold_deg;
-}
-
-ImplicitFlowOptions Simulator::flow_options() const {
+ImplicitFlowOptions Simulator::flow_options() {
   ImplicitFlowOptions options = options_.flow_options;
-  if (options_.refuse_folded)
-    options.abandon = [this](const Eigen::Matrix3Xd& x) { return folded_past_refusal(x); };
+  flow_dead_end_ = "";
+  if (options_.refuse_folded) {
+    DeadEndWatchOptions watch_options;
+    watch_options.refuse_fold_deg = options_.refuse_fold_deg;
+    watch_options.stall_fold_deg = options_.stall_fold_deg;
+    watch_options.stall_steps = options_.refuse_stall_steps;
+    options.abandon = [this, watch = std::make_shared<DeadEndWatch>(mesh(), watch_options)](
+                          const Eigen::Matrix3Xd& x, double residual_n) {
+      if (!watch->dead_end(x, residual_n)) return false;
+      flow_dead_end_ = watch->reason();
+      return true;
+    };
+  }
   return options;
 }
 
@@ -201,6 +213,7 @@ const SettleReport& Simulator::apply(const Action& action, const Eigen::Matrix3X
 const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Matrix3Xd* start) {
   action.validate(mesh(), params());
   dead_end_ = false;
+  flow_dead_end_ = "";
   const DeviceState before = state_;
   const Mesh& m = mesh();
   std::optional<Eigen::Matrix3Xd> predicted;
@@ -277,9 +290,10 @@ const SettleReport& Simulator::apply_from(const Action& action, const Eigen::Mat
   if (!last_.converged) {
     // Where the settle stopped: a folded mesh is the usual reason (mesh_folds.h).
     const std::string folds = find_mesh_folds(m, state_.x).describe();
+    const std::string why = *flow_dead_end_ ? std::string("; the flow ") + flow_dead_end_ : "";
     state_ = before;
     throw NoEquilibrium("no static equilibrium found after " + action.describe() + " (residual " +
-                        std::to_string(last_.residual_n) + " N" + (folds.empty() ? "" : "; " + folds) + ")");
+                        std::to_string(last_.residual_n) + " N" + (folds.empty() ? "" : "; " + folds) + why + ")");
   }
   if (options_.refuse_folded) {
     if (const MeshFolds folds = find_mesh_folds(m, state_.x); folds.sharpest_deg > options_.refuse_fold_deg) {

@@ -59,6 +59,12 @@ struct SimulatorOptions {
   // Planners set it: such a settle is a dead end.
   bool refuse_folded = false;
   double refuse_fold_deg = 150.0;
+  // With refuse_folded, a flow that stays folded past stall_fold_deg for
+  // refuse_stall_steps accepted steps, neither moving any point more than a
+  // quarter of the mesh spacing, net, nor halving its residual, is a dead end
+  // too (sim/dead_end_watch.h); 0 steps: no such limit.
+  double stall_fold_deg = 120.0;
+  int refuse_stall_steps = 20;
   // Effects beyond the baseline, by registry name, and their parameter
   // values (effect name -> parameter name -> value; missing = default).
   std::vector<std::string> extra_effects;
@@ -117,9 +123,9 @@ class Simulator {
   // `rounds` rounds: a polish that pushes off a saddle and does not settle
   // again leaves the state beside it, and the flow goes on from there.
   bool flow_then_polish(int rounds, SettleReport& spent);
-  // options_.flow_options, with SimulatorOptions::refuse_folded: stopping at the first fold.
-  ImplicitFlowOptions flow_options() const;
-  bool folded_past_refusal(const Eigen::Matrix3Xd& x) const;
+  // options_.flow_options, with SimulatorOptions::refuse_folded: stopping
+  // at a dead end (sim/dead_end_watch.h), which sets flow_dead_end_.
+  ImplicitFlowOptions flow_options();
   const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
 
   // The steps the current action's settle has polled (max_settle_steps);
@@ -147,9 +153,11 @@ class Simulator {
   bool keeps_equilibrium_ = false;
   // Set by apply_from while a settle starts from the coarse mesh's dome.
   bool close_start_ = false;
-  // With refuse_folded: the flow from the state before the action folded
-  // the mesh, so the settle ends there without the slower controls.
+  // With refuse_folded: the flow from the state before the action reached a
+  // dead end, so the settle ends there without the slower controls;
+  // flow_dead_end_ says why ("" while the last flow was not abandoned).
   bool dead_end_ = false;
+  const char* flow_dead_end_ = "";
 };
 
 // Parses "static" / "explicit"; std::invalid_argument otherwise.

@@ -1,0 +1,52 @@
+// Tells, step by step, whether a planner's flow has reached a dead end: a
+// fold sharper than the refusal angle (the Eq. 3 normals there are nearly
+// ill-defined), or a folded mesh on which the flow has stalled. There the
+// follower pressure keeps working on the folded flaps, and the flow wanders
+// in place without settling (a 9 x 12 plan's jammed sag at 250 Pa: 400 flow
+// steps, each moving a point up to 1 mm, end within 1.5 mm of where step 40
+// stood, the residual between 1e-3 and 3e-2 N), so the rest of its step
+// budget buys nothing. A snap-through also passes folded states with a
+// residual that does not fall, but it is going somewhere: a 5 x 7 jammed sag
+// inverting into a dome at 350 Pa moves 20-30 mm every 20 steps.
+#pragma once
+
+#include <Eigen/Core>
+#include <deque>
+
+#include "model/mesh.h"
+
+namespace hj {
+
+struct DeadEndWatchOptions {
+  double refuse_fold_deg = 150.0;  // a fold past this ends the flow at once
+  // Folded past stall_fold_deg for stall_steps accepted steps in which no
+  // point moved more than stall_move_fraction of the mesh spacing, net, and
+  // the residual did not halve, the flow has stalled (stall_steps 0: never).
+  double stall_fold_deg = 120.0;
+  int stall_steps = 20;
+  double stall_move_fraction = 0.25;
+};
+
+class DeadEndWatch {
+ public:
+  DeadEndWatch(const Mesh& mesh, DeadEndWatchOptions options) : mesh_(&mesh), options_(options) {}
+
+  // After each accepted flow step: true if the flow is a dead end.
+  bool dead_end(const Eigen::Matrix3Xd& x, double residual_n);
+  // Why the last dead_end() said true ("" before it did).
+  const char* reason() const { return reason_; }
+
+ private:
+  bool stalled(const Eigen::Matrix3Xd& x, double residual_n);
+
+  const Mesh* mesh_;
+  DeadEndWatchOptions options_;
+  // The positions of the last stall_steps + 1 folded steps, oldest first,
+  // and the best residual since it last halved (steps_since_best ago).
+  std::deque<Eigen::Matrix3Xd> window_;
+  double best_residual_ = 0.0;
+  int steps_since_best_ = 0;
+  const char* reason_ = "";
+};
+
+}  // namespace hj

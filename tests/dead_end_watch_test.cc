@@ -1,0 +1,115 @@
+// The planner's dead-end watch (sim/dead_end_watch.h): a fold past the
+// refusal angle ends a flow at once; a folded mesh that has stopped moving
+// and whose residual has stopped falling ends it after the stall limit; an
+// unfolded mesh, a moving one, or a residual that keeps falling, never does.
+#include "sim/dead_end_watch.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "sim/mesh_folds.h"
+#include "sim/simulator.h"
+
+namespace hj {
+namespace {
+
+// A 2 x 2 mesh (p = 4) whose point (3, 5) is turned back 130 degrees from
+// +x about point (3, 4): folded past 120 degrees, not past 150 anywhere.
+Eigen::Matrix3Xd folded_between_the_limits(const Mesh& mesh) {
+  Eigen::Matrix3Xd x = mesh.rest_positions();
+  const double h = mesh.spacing(), turn = 130.0 * M_PI / 180.0;
+  x.col(mesh.index(3, 5)) = x.col(mesh.index(3, 4)) + h * Eigen::Vector3d(std::cos(turn), 0.0, std::sin(turn));
+  return x;
+}
+
+constexpr DeadEndWatchOptions kOptions{150.0, 120.0, 20};
+
+TEST(DeadEndWatch, AnUnfoldedMeshIsNeverADeadEndHoweverTheResidualStalls) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  DeadEndWatch watch(mesh, kOptions);
+  for (int step = 0; step < 200; ++step) EXPECT_FALSE(watch.dead_end(mesh.rest_positions(), 0.01)) << step;
+}
+
+TEST(DeadEndWatch, AFoldPastTheRefusalAngleIsADeadEndAtOnce) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  Eigen::Matrix3Xd x = mesh.rest_positions();
+  x(0, mesh.index(3, 4)) -= 1.5 * mesh.spacing();  // turned back by 180 degrees
+  DeadEndWatch watch(mesh, kOptions);
+  EXPECT_TRUE(watch.dead_end(x, 1.0));
+  EXPECT_EQ(std::string(watch.reason()), "folded past the refusal angle");
+}
+
+TEST(DeadEndWatch, AFoldedMeshThatStandsStillAndStopsFallingIsADeadEndAfterTheStallLimit) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  const Eigen::Matrix3Xd x = folded_between_the_limits(mesh);
+  const double sharpest = find_mesh_folds(mesh, x).sharpest_deg;
+  ASSERT_GT(sharpest, kOptions.stall_fold_deg);
+  ASSERT_LT(sharpest, kOptions.refuse_fold_deg);
+  DeadEndWatch watch(mesh, kOptions);
+  // The mesh stands still; the residual wanders (0.6 to 1.4 x its first
+  // value) but never halves.
+  int step = 0;
+  while (!watch.dead_end(x, 1.0 + 0.4 * std::sin(step))) {
+    ++step;
+    ASSERT_LE(step, kOptions.stall_steps) << "not a dead end after " << step << " stalled steps";
+  }
+  EXPECT_EQ(step, kOptions.stall_steps);
+  EXPECT_EQ(std::string(watch.reason()), "stalled on a folded mesh");
+}
+
+// A snap-through passes folded states with a residual that does not fall,
+// but the surface is on its way: here it moves 0.05 h a step, 1 h in 20.
+TEST(DeadEndWatch, AFoldedMeshThatKeepsMovingIsNoDeadEndHoweverTheResidualStalls) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  const Eigen::Matrix3Xd x = folded_between_the_limits(mesh);
+  DeadEndWatch watch(mesh, kOptions);
+  for (int step = 0; step < 200; ++step) {
+    const Eigen::Matrix3Xd moved = x.colwise() + Eigen::Vector3d(0.0, 0.0, 0.05 * step * mesh.spacing());
+    EXPECT_FALSE(watch.dead_end(moved, 1.0)) << step;
+  }
+}
+
+TEST(DeadEndWatch, AFoldedMeshWhoseResidualKeepsFallingIsNoDeadEnd) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  const Eigen::Matrix3Xd x = folded_between_the_limits(mesh);
+  DeadEndWatch watch(mesh, kOptions);
+  // Halving every 10 steps, slower than every step but within the limit.
+  for (int step = 0; step < 200; ++step)
+    EXPECT_FALSE(watch.dead_end(x, std::pow(0.5, step / 10.0))) << step;
+}
+
+TEST(DeadEndWatch, UnfoldingStartsTheStallCountAgain) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  const Eigen::Matrix3Xd folded = folded_between_the_limits(mesh);
+  DeadEndWatch watch(mesh, kOptions);
+  for (int round = 0; round < 5; ++round) {
+    for (int step = 0; step < kOptions.stall_steps; ++step) EXPECT_FALSE(watch.dead_end(folded, 1.0));
+    EXPECT_FALSE(watch.dead_end(mesh.rest_positions(), 1.0));
+  }
+}
+
+TEST(DeadEndWatch, ZeroStallStepsTurnTheStallLimitOff) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  DeadEndWatch watch(mesh, DeadEndWatchOptions{150.0, 120.0, 0});
+  for (int step = 0; step < 200; ++step) EXPECT_FALSE(watch.dead_end(folded_between_the_limits(mesh), 1.0));
+}
+
+TEST(DeadEndWatch, TheSimulatorNamesABadStallOption) {
+  const ArrayGeometry g{1, 2, 0.038, 4};
+  SimulatorOptions options;
+  options.stall_fold_deg = 160.0;  // above refuse_fold_deg
+  try {
+    Simulator sim(g, SurfaceParameters::paper_defaults(g), options);
+    FAIL() << "accepted stall_fold_deg above refuse_fold_deg";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("stall_fold_deg"), std::string::npos) << e.what();
+  }
+  options = {};
+  options.refuse_stall_steps = -1;
+  EXPECT_THROW(Simulator(g, SurfaceParameters::paper_defaults(g), options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hj
