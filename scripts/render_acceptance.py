@@ -11,7 +11,7 @@ starts hapticjam-server on it, runs `hapticjam remote render --json` and
 reads the true surface afterwards.
 
   scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...]
-                               [--corrections targets,model,both] [--planner NAME]
+                               [--corrections targets,model,both] [--planner NAME] [--device-segments P]
 
 Besides the table, one line per run lists the MAE and r of every iteration,
 its planning and fitting seconds and the model fitted last (correction
@@ -140,13 +140,15 @@ def start(argv, pattern, log):
     raise RuntimeError(f"{argv[0]} did not start: " + open(log + ".err").read())
 
 
-def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain, planner, correction):
+def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain, planner, correction,
+             device_segments=8):
     rows, cols = size
     params = os.path.join(work, "device.json")
     with open(params, "w") as f:
         json.dump({"format": "hapticjam.params/1", "effects": CASES[case]}, f)
     emulator, port = start([os.path.join(build, "src/device/hapticjam-device-emulator"), "--listen", "127.0.0.1:0",
-                            "--rows", str(rows), "--cols", str(cols), "--segments", "8", "--params", params,
+                            "--rows", str(rows), "--cols", str(cols), "--segments", str(device_segments),
+                            "--params", params,
                             "--noise-mm", str(noise), "--seed", "11"],
                            r"listening on 127\.0\.0\.1:(\d+)", os.path.join(work, "emulator"))
     server = None
@@ -224,6 +226,7 @@ def main():
     ap.add_argument("--iterations", type=int, default=5)
     ap.add_argument("--planner", default="", help="the server's planner for each iteration (default: the server's)")
     ap.add_argument("--noise-mm", type=float, default=1.0)
+    ap.add_argument("--device-segments", type=int, default=8, help="the emulator's mesh (the planner's is 4)")
     ap.add_argument("--gain", type=float, default=0.0, help="of the target correction (0: the server's default)")
     ap.add_argument("--corrections", default="targets",
                     help="comma-separated: targets, model, both, none (each case runs with each)")
@@ -243,7 +246,8 @@ def main():
                     with tempfile.TemporaryDirectory(prefix="hj_render_") as work:
                         try:
                             run = run_case(args.build, work, case, size, goal_name, sequences(*size)[goal_name],
-                                           args.iterations, args.noise_mm, args.gain, args.planner, correction)
+                                           args.iterations, args.noise_mm, args.gain, args.planner, correction,
+                                           args.device_segments)
                         except RuntimeError as e:
                             print(f"| {size_text} | {case} | {goal_name} | {correction} | failed: {e} |||||||",
                                   flush=True)

@@ -2,11 +2,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "calib/measurement_effects.h"
 #include "calib/rasterize.h"
 #include "json_log.h"
+#include "metrics/correction_screen.h"
 #include "metrics/height_error.h"
 #include "plan/planner.h"
 #include "render_calibration.h"
@@ -115,17 +117,21 @@ class RenderRun {
     v1::RenderResult result;
     result.set_point_rows(mesh_.point_rows()), result.set_point_cols(mesh_.point_cols());
     add_heights(setup_.goal_mm, result.mutable_goal_heights_mm());
-    double best_mae = INFINITY;
     std::string stop = "the iteration limit (" + std::to_string(setup_.iterations) + ")";
     for (int i = 1; i <= setup_.iterations; ++i) {
-      v1::RenderIteration it = iterate(i);
+      std::optional<v1::RenderIteration> ran = iterate(i);
+      if (!ran) {
+        stop = screen_stop_;
+        break;
+      }
+      v1::RenderIteration& it = *ran;
       result.add_job_ids(it.job_id());
       result.set_iterations(i);
       if (i == 1) *result.mutable_open_loop_error() = it.error();
       const double mae = it.error().mae_mm();
-      const bool improved = mae < best_mae * (1.0 - kMinImprovement);
-      if (mae < best_mae) {
-        best_mae = mae;
+      const bool improved = mae < best_mae_ * (1.0 - kMinImprovement);
+      if (mae < best_mae_) {
+        best_mae_ = mae;
         result.set_best_iteration(i);
         *result.mutable_error() = it.error();
       }
@@ -262,19 +268,23 @@ class RenderRun {
     return run_on_device(i, steps, " (first " + std::to_string(steps.size()) + " steps)");
   }
 
-  v1::RenderIteration iterate(int i) {
+  // One run: plan (screened from the second on), run on the device,
+  // capture, compare, correct; nullopt when the screen ends the render.
+  std::optional<v1::RenderIteration> iterate(int i) {
     v1::RenderIteration it;
     it.set_iteration(i);
     const auto planning_start = Clock::now();
-    const PlanResult planned = plan(i);
+    std::optional<PlanResult> planned = plan(i);
+    if (i > 1 && learns_targets(setup_.correction)) planned = screened(i, std::move(*planned), it);
     it.set_planning_seconds(seconds_since(planning_start));
+    if (!planned) return std::nullopt;
 
-    for (const Action& a : planned.steps) action_to_proto(a, it.mutable_plan()->add_steps());
+    for (const Action& a : planned->steps) action_to_proto(a, it.mutable_plan()->add_steps());
     it.mutable_plan()->set_planner(setup_.planner);
 
     const auto device_start = Clock::now();
-    std::vector<Action> steps = planned.steps;
-    DeviceState predicted_state = planned.final_state;
+    std::vector<Action> steps = planned->steps;
+    DeviceState predicted_state = planned->final_state;
     v1::Job job = run_on_device(i, steps, "");
     if (refused_part_way(job, steps.size())) job = rerun_before_refusal(i, job, steps, predicted_state, it);
     it.set_steps_run(int(steps.size()));
@@ -305,8 +315,51 @@ class RenderRun {
     } catch (const std::invalid_argument& e) {
       throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
     }
-    it.set_correction(correct(whole_plan_outcome(measured, predicted, planned, it), it));
+    previous_targets_ = targets_, last_measured_ = measured, last_predicted_ = predicted;
+    last_grid_ = it.capture().grid();
+    it.set_correction(correct(whole_plan_outcome(measured, predicted, *planned, it), it));
     return it;
+  }
+
+  // A corrected plan runs only if the device is expected to make it no
+  // clearly worse than its best run (metrics/correction_screen.h); else the
+  // correction is halved and replanned. nullopt: none passed, the render
+  // ends at its best (screen_stop_ says why).
+  std::optional<PlanResult> screened(int i, PlanResult planned, v1::RenderIteration& it) {
+    const CorrectionScreenOptions options;
+    std::ostringstream s;
+    s.precision(3);
+    for (int halvings = 0;; ++halvings) {
+      const double expected = expected_mae(i, planned);
+      s << (halvings ? ", then " : "expected ") << expected << " mm";
+      if (passes_screen(expected, best_mae_, options)) {
+        s << " against the best run's " << best_mae_ << " mm: run";
+        if (halvings) s << ", the correction halved " << halvings << (halvings > 1 ? " times" : " time");
+        it.set_screening(s.str());
+        return planned;
+      }
+      if (halvings == options.max_halvings) {
+        screen_stop_ = "the corrected plans were expected worse than the best run (" + s.str() + " against " +
+                       std::to_string(best_mae_) + " mm, the correction halved " + std::to_string(halvings) +
+                       " times)";
+        log_event("render_screen_stop", {{"iteration", i}, {"reason", screen_stop_}});
+        return std::nullopt;
+      }
+      progress(i, 0.0, "the corrected plan is expected " + std::to_string(expected) + " mm from the goal: halving the correction");
+      targets_ = halved_correction(previous_targets_, targets_);
+      planned = plan(i);
+    }
+  }
+
+  // The goal against what the device is expected to make of `planned`.
+  double expected_mae(int i, const PlanResult& planned) const {
+    const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, planned.final_state.x, last_grid_);
+    try {
+      return height_error(setup_.goal_mm, expected_outcome(predicted, last_measured_, last_predicted_)).mae_mm;
+    } catch (const std::invalid_argument& e) {
+      throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": screening its plan: " +
+                                                  e.what());
+    }
   }
 
   // The device model refitted on every run so far, this one included;
@@ -392,6 +445,12 @@ class RenderRun {
   const RenderHooks& hooks_;
   const Mesh mesh_;
   Eigen::MatrixXd targets_;
+  // The best MAE against the goal so far; the last run's targets, and its
+  // capture and prediction at the mesh points, for screening the next plan.
+  double best_mae_ = INFINITY;
+  Eigen::MatrixXd previous_targets_, last_measured_, last_predicted_;
+  v1::CaptureGrid last_grid_;
+  std::string screen_stop_;
   RenderCalibration calibration_;
   v1::FittedModel last_model_;
 };

@@ -85,6 +85,10 @@ TEST(RenderE2e, TheErrorFallsFromTheFirstIterationToTheLastAndTheTrueSurfaceImpr
   for (const char* key : {"iterations", "mae_mm", "rmse_mm", "correlation", "open_loop_mae_mm"})
     EXPECT_TRUE(result.contains(key)) << key << " missing in " << result;
   EXPECT_EQ(first["iteration"], 1);
+  // The first plan is the planner's own; every corrected one was screened.
+  EXPECT_TRUE(first["screening"].is_null()) << first;
+  for (std::size_t k = 1; k + 1 < lines.size(); ++k)
+    EXPECT_NE(lines[k]["screening"].get<std::string>().find("expected"), std::string::npos) << lines[k];
   EXPECT_LT(last["mae_mm"].get<double>(), first["mae_mm"].get<double>()) << r.out;
   EXPECT_DOUBLE_EQ(result["open_loop_mae_mm"].get<double>(), first["mae_mm"].get<double>());
   EXPECT_LE(result["mae_mm"].get<double>(), last["mae_mm"].get<double>());

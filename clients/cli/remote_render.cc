@@ -128,6 +128,7 @@ nlohmann::json iteration_line(const v1::RenderIteration& it) {
           {"rmse_mm", it.error().rmse_mm()},
           {"correlation", number_or_null(it.error().has_correlation(), it.error().correlation())},
           {"correction", it.correction()},
+          {"screening", it.screening().empty() ? nlohmann::json(nullptr) : nlohmann::json(it.screening())},
           {"prediction_mae_mm", it.prediction_error().mae_mm()},
           {"camera_tilt_mrad", {it.camera().tilt_x_mrad(), it.camera().tilt_y_mrad()}},
           {"camera_offset_mm", it.camera().offset_mm()},
@@ -191,6 +192,7 @@ int remote_render(const RemoteRenderArgs& args) {
                      it.iteration(), it.error().mae_mm(), it.error().rmse_mm(),
                      it.error().has_correlation() ? std::to_string(it.error().correlation()).substr(0, 6).c_str() : "-",
                      it.prediction_error().mae_mm(), it.correction().c_str());
+        if (!it.screening().empty()) std::fprintf(stderr, "  its plan, screened: %s\n", it.screening().c_str());
         if (!it.refusal().empty())
           std::fprintf(stderr, "  the device refused step %d of %d (%s): captured after the steps before it\n",
                        it.steps_run(), it.plan().steps_size(), it.refusal().c_str());

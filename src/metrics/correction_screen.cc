@@ -1,0 +1,41 @@
+#include "metrics/correction_screen.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hj {
+
+namespace {
+
+void check_same_shape(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const char* what) {
+  if (a.rows() != b.rows() || a.cols() != b.cols())
+    throw std::invalid_argument(std::string(what) + ": " + std::to_string(a.rows()) + " x " +
+                                std::to_string(a.cols()) + " against " + std::to_string(b.rows()) + " x " +
+                                std::to_string(b.cols()));
+}
+
+}  // namespace
+
+Eigen::MatrixXd expected_outcome(const Eigen::MatrixXd& predicted_next_mm, const Eigen::MatrixXd& last_measured_mm,
+                                 const Eigen::MatrixXd& last_predicted_mm) {
+  check_same_shape(predicted_next_mm, last_measured_mm, "expected_outcome (prediction, last capture)");
+  check_same_shape(last_measured_mm, last_predicted_mm, "expected_outcome (last capture, last prediction)");
+  return predicted_next_mm + (last_measured_mm - last_predicted_mm);
+}
+
+Eigen::MatrixXd halved_correction(const Eigen::MatrixXd& previous_mm, const Eigen::MatrixXd& corrected_mm) {
+  check_same_shape(previous_mm, corrected_mm, "halved_correction (previous, corrected targets)");
+  return 0.5 * (previous_mm + corrected_mm);
+}
+
+bool passes_screen(double expected_mae, double best_mae, const CorrectionScreenOptions& options) {
+  if (!(best_mae >= 0.0) || !std::isfinite(best_mae))
+    throw std::invalid_argument("passes_screen: the best MAE must be a finite number of mm >= 0");
+  if (!(options.tolerance >= 1.0) || !std::isfinite(options.tolerance))
+    throw std::invalid_argument("CorrectionScreenOptions.tolerance must be a finite number >= 1");
+  if (options.max_halvings < 0) throw std::invalid_argument("CorrectionScreenOptions.max_halvings must be >= 0");
+  return expected_mae <= options.tolerance * best_mae;  // a NaN expectation never passes
+}
+
+}  // namespace hj
