@@ -135,6 +135,18 @@ TEST(SweepCli, WritesTheTableTheFitAndBothFigures) {
             "goal,rows,cols,cells,correlation,laplace_mean_a0,laplace_mean_a1_8,laplace_mean_a1_4,laplace_mean_a1_2,"
             "laplace_mean_a1,steps,refused,relief_mm,seconds,settle_seconds,refused_seconds,status,detail,note");
   EXPECT_NE(table.find("bump,2,3,6,"), std::string::npos);
+  // Each row's time splits into the settles kept and refused, within its whole.
+  std::istringstream rows(table.substr(table.find('\n') + 1));
+  for (std::string row; std::getline(rows, row);) {
+    std::vector<std::string> cells;
+    std::istringstream fields(row);
+    for (std::string cell; std::getline(fields, cell, ',');) cells.push_back(cell);
+    ASSERT_GE(cells.size(), 16u) << row;
+    const double seconds = std::stod(cells[13]), kept = std::stod(cells[14]), refused = std::stod(cells[15]);
+    EXPECT_GT(kept, 0.0) << row;
+    EXPECT_GE(refused, 0.0) << row;
+    EXPECT_LE(kept + refused, seconds) << row;
+  }
   const std::string t2 = read_text(out / "table2.csv");
   EXPECT_EQ(t2.substr(0, t2.find('\n')), "alpha_l,slope,intercept,r2,n,paper_r2");
   EXPECT_NE(t2.find("0.7583"), std::string::npos);  // the paper's r^2 at alpha_L = 1/8
