@@ -69,9 +69,12 @@ Portfolio::Portfolio(PortfolioOptions options) : options_(options) { options_.va
 std::vector<std::pair<std::string, std::unique_ptr<Planner>>> Portfolio::strategies() {
   std::vector<std::pair<std::string, std::unique_ptr<Planner>>> out;
   out.emplace_back("algorithm2", std::make_unique<Algorithm2>());
+  // Started second, beside Algorithm 2: over the 11 shared goals x 16 sizes
+  // from-above won 53 of the 80 plans it finished when it was started last,
+  // and the time budget stopped it in the other 96.
+  out.emplace_back("from-above", std::make_unique<FromAbove>());
   out.emplace_back("algorithm2-levelled x1", make_algorithm2_levelled(1.0));
   out.emplace_back("algorithm2-levelled x2", make_algorithm2_levelled(2.0));
-  out.emplace_back("from-above", std::make_unique<FromAbove>());
   return out;
 }
 
