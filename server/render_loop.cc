@@ -339,13 +339,12 @@ class RenderRun {
         return planned;
       }
       if (halvings == options.max_halvings) {
-        screen_stop_ = "the corrected plans were expected worse than the best run (" + s.str() + " against " +
-                       std::to_string(best_mae_) + " mm, the correction halved " + std::to_string(halvings) +
-                       " times)";
+        s << " against the best run's " << best_mae_ << " mm, the correction halved " << halvings << " times";
+        screen_stop_ = "the corrected plans were expected worse than the best run (" + s.str() + ")";
         log_event("render_screen_stop", {{"iteration", i}, {"reason", screen_stop_}});
         return std::nullopt;
       }
-      progress(i, 0.0, "the corrected plan is expected " + std::to_string(expected) + " mm from the goal: halving the correction");
+      progress(i, 0.0, "the corrected plan is expected worse than the best run: halving the correction");
       targets_ = halved_correction(previous_targets_, targets_);
       planned = plan(i);
     }

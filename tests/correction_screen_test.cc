@@ -54,7 +54,7 @@ TEST(CorrectionScreen, BadShapesAndOptionsAreNamed) {
   try {
     halved_correction(a, b);
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("2 x 2 against 2 x 3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shapes differ, 2 x 2 and 2 x 3"), std::string::npos) << e.what();
   }
 }
 

@@ -2,20 +2,10 @@
 
 #include <cmath>
 #include <stdexcept>
-#include <string>
+
+#include "metrics/same_shape.h"
 
 namespace hj {
-
-namespace {
-
-void check_same_shape(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const char* what) {
-  if (a.rows() != b.rows() || a.cols() != b.cols())
-    throw std::invalid_argument(std::string(what) + ": " + std::to_string(a.rows()) + " x " +
-                                std::to_string(a.cols()) + " against " + std::to_string(b.rows()) + " x " +
-                                std::to_string(b.cols()));
-}
-
-}  // namespace
 
 Eigen::MatrixXd expected_outcome(const Eigen::MatrixXd& predicted_next_mm, const Eigen::MatrixXd& last_measured_mm,
                                  const Eigen::MatrixXd& last_predicted_mm) {
@@ -29,12 +19,16 @@ Eigen::MatrixXd halved_correction(const Eigen::MatrixXd& previous_mm, const Eige
   return 0.5 * (previous_mm + corrected_mm);
 }
 
+void CorrectionScreenOptions::validate() const {
+  if (!(tolerance >= 1.0) || !std::isfinite(tolerance))
+    throw std::invalid_argument("CorrectionScreenOptions.tolerance must be a finite number >= 1");
+  if (max_halvings < 0) throw std::invalid_argument("CorrectionScreenOptions.max_halvings must be >= 0");
+}
+
 bool passes_screen(double expected_mae, double best_mae, const CorrectionScreenOptions& options) {
   if (!(best_mae >= 0.0) || !std::isfinite(best_mae))
     throw std::invalid_argument("passes_screen: the best MAE must be a finite number of mm >= 0");
-  if (!(options.tolerance >= 1.0) || !std::isfinite(options.tolerance))
-    throw std::invalid_argument("CorrectionScreenOptions.tolerance must be a finite number >= 1");
-  if (options.max_halvings < 0) throw std::invalid_argument("CorrectionScreenOptions.max_halvings must be >= 0");
+  options.validate();
   return expected_mae <= options.tolerance * best_mae;  // a NaN expectation never passes
 }
 

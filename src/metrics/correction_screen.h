@@ -15,6 +15,9 @@ struct CorrectionScreenOptions {
   // measured MAE so far (the expectation carries the last capture's noise).
   double tolerance = 1.25;
   int max_halvings = 3;  // past them the loop ends at its best
+
+  // Throws std::invalid_argument naming the bad field.
+  void validate() const;
 };
 
 // What the device is expected to make of a plan: its predicted surface

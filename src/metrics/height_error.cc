@@ -1,5 +1,7 @@
 #include "metrics/height_error.h"
 
+#include "metrics/same_shape.h"
+
 #include <algorithm>
 #include <Eigen/Dense>
 #include <cmath>
@@ -8,13 +10,6 @@
 
 namespace hj {
 namespace {
-
-std::string shape(const Eigen::MatrixXd& m) { return std::to_string(m.rows()) + " x " + std::to_string(m.cols()); }
-
-void check_same_shape(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const char* what) {
-  if (a.rows() != b.rows() || a.cols() != b.cols())
-    throw std::invalid_argument(std::string(what) + ": shapes differ, " + shape(a) + " and " + shape(b));
-}
 
 // The frame at (x, y) mm, bilinear over the valid samples of the cell around it.
 double interpolate(const Eigen::MatrixXd& frame, const FrameGrid& g, double x_mm, double y_mm) {
@@ -41,7 +36,7 @@ double interpolate(const Eigen::MatrixXd& frame, const FrameGrid& g, double x_mm
 
 Eigen::MatrixXd frame_at_rest_points(const Mesh& mesh, const Eigen::MatrixXd& frame_mm, const FrameGrid& grid) {
   if (frame_mm.rows() != grid.ny || frame_mm.cols() != grid.nx)
-    throw std::invalid_argument("frame of " + shape(frame_mm) + " samples for a grid of ny x nx = " +
+    throw std::invalid_argument("frame of " + shape_text(frame_mm) + " samples for a grid of ny x nx = " +
                                 std::to_string(grid.ny) + " x " + std::to_string(grid.nx));
   if (!(grid.dx_mm > 0.0) || !(grid.dy_mm > 0.0)) throw std::invalid_argument("frame grid spacing must be positive");
   const double h_mm = mesh.spacing() * 1000.0;
@@ -83,7 +78,7 @@ double plane_at(const Mesh& mesh, const CameraPlane& plane, int i, int j) {
 CameraPlane fit_camera_plane(const Mesh& mesh, const Eigen::MatrixXd& measured_mm) {
   const int n_i = mesh.point_rows(), n_j = mesh.point_cols();
   if (measured_mm.rows() != n_i || measured_mm.cols() != n_j)
-    throw std::invalid_argument("fit_camera_plane: " + shape(measured_mm) + " heights for a mesh of " +
+    throw std::invalid_argument("fit_camera_plane: " + shape_text(measured_mm) + " heights for a mesh of " +
                                 std::to_string(n_i) + " x " + std::to_string(n_j) + " points");
   const double h_mm = mesh.spacing() * 1000.0;
   const double xc = 0.5 * (n_j - 1) * h_mm, yc = 0.5 * (n_i - 1) * h_mm;
