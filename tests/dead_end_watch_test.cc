@@ -1,7 +1,8 @@
 // The planner's dead-end watch (sim/dead_end_watch.h): a fold past the
 // refusal angle ends a flow at once; a folded mesh that has stopped moving
-// and whose residual has stopped falling ends it after the stall limit; an
-// unfolded mesh, a moving one, or a residual that keeps falling, never does.
+// and whose residual has stopped falling ends it after the stall limit, as
+// does a flow that comes back to a state it passed; an unfolded mesh, a
+// moving one, or a residual that keeps falling, never does.
 #include "sim/dead_end_watch.h"
 
 #include <gtest/gtest.h>
@@ -80,13 +81,32 @@ TEST(DeadEndWatch, AFoldedMeshWhoseResidualKeepsFallingIsNoDeadEnd) {
     EXPECT_FALSE(watch.dead_end(x, std::pow(0.5, step / 10.0))) << step;
 }
 
-TEST(DeadEndWatch, UnfoldingStartsTheStallCountAgain) {
+// A cycle: folds come and go, and the flow keeps coming back to where it
+// was (the Luxembourg 9 x 12 sag, period about 40 steps).
+TEST(DeadEndWatch, AFlowThatComesBackToAFoldedStateItPassedIsADeadEndThoughItUnfoldedBetween) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
   const Eigen::Matrix3Xd folded = folded_between_the_limits(mesh);
   DeadEndWatch watch(mesh, kOptions);
-  for (int round = 0; round < 5; ++round) {
-    for (int step = 0; step < kOptions.stall_steps; ++step) EXPECT_FALSE(watch.dead_end(folded, 1.0));
-    EXPECT_FALSE(watch.dead_end(mesh.rest_positions(), 1.0));
+  const int half_period = kOptions.stall_steps / 2 + 1;
+  int step = 0;
+  for (; step < 10 * half_period; ++step) {
+    const bool away = (step / half_period) % 2 == 1;
+    const Eigen::Matrix3Xd x = away ? Eigen::Matrix3Xd(mesh.rest_positions()) : folded;
+    if (watch.dead_end(x, 1.0)) break;
+  }
+  EXPECT_EQ(step, 2 * half_period) << "the first return to the folded state";
+  EXPECT_EQ(std::string(watch.reason()), "stalled on a folded mesh");
+}
+
+// A snap-through that unfolds on its way never comes back.
+TEST(DeadEndWatch, AFlowThatFoldsUnfoldsAndMovesOnIsNoDeadEnd) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  const Eigen::Matrix3Xd folded = folded_between_the_limits(mesh);
+  DeadEndWatch watch(mesh, kOptions);
+  for (int step = 0; step < 200; ++step) {
+    const Eigen::Matrix3Xd base = step % 7 == 6 ? Eigen::Matrix3Xd(mesh.rest_positions()) : folded;
+    const Eigen::Matrix3Xd moved = base.colwise() + Eigen::Vector3d(0.0, 0.0, 0.05 * step * mesh.spacing());
+    EXPECT_FALSE(watch.dead_end(moved, 1.0)) << step;
   }
 }
 

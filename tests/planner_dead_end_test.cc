@@ -1,5 +1,5 @@
 // A planner's settles through folded meshes (sim/dead_end_watch.h): a flow
-// that wanders in place on a folded sag is refused as a dead end before its
+// that wanders in place or cycles on a folded sag is refused as a dead end before its
 // step budget, and one that snaps through folded states into a dome still
 // settles.
 #include <gtest/gtest.h>
@@ -31,6 +31,18 @@ TEST(PlannerDeadEnd, AFlowThatWandersOnAFoldedSagIsRefusedAsStalled) {
   }
   EXPECT_EQ(sim.state().pressure_pa, before.pressure_pa);
   EXPECT_EQ((sim.state().x - before.x).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// Before the watch knew cycles, this settle spent the planner's whole step
+// budget (150 steps).
+TEST(PlannerDeadEnd, AFlowThatCyclesOnAFoldedSagIsRefusedAsStalled) {
+  Simulator sim = planner_simulator({9, 12, 0.038, 4}, testing::luxembourg_9x12_cycling_sag());
+  try {
+    sim.apply(Action::set_pressure(250.0));
+    FAIL() << "250 Pa settled";
+  } catch (const NoEquilibrium& e) {
+    EXPECT_NE(std::string(e.what()).find("the flow stalled on a folded mesh"), std::string::npos) << e.what();
+  }
 }
 
 TEST(PlannerDeadEnd, ASagThatSnapsThroughFoldedStatesIntoADomeSettles) {

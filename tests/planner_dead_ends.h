@@ -45,4 +45,20 @@ inline std::vector<Action> volcano_5x7_jammed_sag() {
   return steps;
 }
 
+// luxembourg_elev.csv on 9 x 12, its first 49 steps: 44 cells jammed in the
+// sag, 200 Pa. At 250 Pa the flow swings in a cycle of about 40 steps, its
+// folds coming and going around 120 degrees, back within 0.4 mm of itself.
+inline std::vector<Action> luxembourg_9x12_cycling_sag() {
+  std::vector<Action> steps{Action::set_pressure(50.0)};
+  add_jams(steps, {{0, 3}, {0, 4}, {0, 5}, {0, 6}, {0, 7}, {0, 8}, {0, 9}, {1, 1}, {1, 2}, {1, 6}, {1, 8},
+                   {1, 9}, {2, 1}, {2, 10}, {2, 11}, {3, 0}, {3, 1}, {3, 5}, {4, 5}, {4, 8}, {4, 10}, {4, 11},
+                   {5, 0}, {5, 1}, {5, 2}, {5, 6}, {5, 10}, {5, 11}, {6, 3}, {6, 6}, {6, 8}, {6, 10}, {6, 11},
+                   {7, 0}, {7, 4}, {7, 5}, {7, 7}, {7, 8}, {7, 9}, {8, 3}, {8, 6}});
+  for (double p : {100.0, 150.0}) steps.push_back(Action::set_pressure(p));
+  add_jams(steps, {{0, 11}, {5, 8}, {8, 10}});
+  steps.push_back(Action::set_pressure(200.0));
+  add_jams(steps, {{8, 7}});
+  return steps;
+}
+
 }  // namespace hj::testing

@@ -4,35 +4,32 @@
 
 namespace hj {
 
+namespace {
+constexpr std::size_t kMaxHistory = 400;
+}  // namespace
+
 bool DeadEndWatch::dead_end(const Eigen::Matrix3Xd& x, double residual_n) {
   const double sharpest = find_mesh_folds(*mesh_, x).sharpest_deg;
   if (sharpest > options_.refuse_fold_deg) {
     reason_ = "folded past the refusal angle";
     return true;
   }
-  if (options_.stall_steps == 0 || sharpest <= options_.stall_fold_deg) {
-    window_.clear();  // the count starts anew on the next folded step
-    best_residual_ = 0.0;
-    return false;
-  }
-  if (!stalled(x, residual_n)) return false;
+  const bool stalled = options_.stall_steps > 0 && sharpest > options_.stall_fold_deg && returned(x, residual_n);
+  history_.push_back({x, residual_n});
+  if (history_.size() > kMaxHistory) history_.pop_front();
+  if (!stalled) return false;
   reason_ = "stalled on a folded mesh";
   return true;
 }
 
-bool DeadEndWatch::stalled(const Eigen::Matrix3Xd& x, double residual_n) {
-  if (best_residual_ == 0.0 || residual_n < 0.5 * best_residual_) {
-    best_residual_ = residual_n;
-    steps_since_best_ = 0;
-  } else {
-    ++steps_since_best_;
+bool DeadEndWatch::returned(const Eigen::Matrix3Xd& x, double residual_n) const {
+  const double near = options_.stall_move_fraction * mesh_->spacing();
+  const int old_enough = static_cast<int>(history_.size()) - options_.stall_steps + 1;
+  for (int i = 0; i < old_enough; ++i) {
+    const Passed& passed = history_[i];
+    if (residual_n >= 0.5 * passed.residual_n && (x - passed.x).colwise().norm().maxCoeff() < near) return true;
   }
-  window_.push_back(x);
-  if (static_cast<int>(window_.size()) > options_.stall_steps + 1) window_.pop_front();
-  if (static_cast<int>(window_.size()) <= options_.stall_steps || steps_since_best_ < options_.stall_steps)
-    return false;
-  const double net_move = (x - window_.front()).colwise().norm().maxCoeff();
-  return net_move < options_.stall_move_fraction * mesh_->spacing();
+  return false;
 }
 
 }  // namespace hj

@@ -7,11 +7,17 @@
 // stood, the residual between 1e-3 and 3e-2 N), so the rest of its step
 // budget buys nothing. A snap-through also passes folded states with a
 // residual that does not fall, but it is going somewhere: a 5 x 7 jammed sag
-// inverting into a dome at 350 Pa moves 20-30 mm every 20 steps.
+// inverting into a dome at 350 Pa moves 20-30 mm every 20 steps. A flow may
+// also cycle: a 9 x 12 plan's jammed sag at 250 Pa (Luxembourg) swings with
+// a period of about 40 steps, folds coming and going around 120 degrees, and
+// comes back within 0.4 mm of where it stood a period before. Both are a
+// return: the flow stands, folded, near a state it passed at least
+// stall_steps before, and its residual has not halved since.
 #pragma once
 
 #include <Eigen/Core>
 #include <deque>
+#include <string>
 
 #include "model/mesh.h"
 
@@ -19,9 +25,10 @@ namespace hj {
 
 struct DeadEndWatchOptions {
   double refuse_fold_deg = 150.0;  // a fold past this ends the flow at once
-  // Folded past stall_fold_deg for stall_steps accepted steps in which no
-  // point moved more than stall_move_fraction of the mesh spacing, net, and
-  // the residual did not halve, the flow has stalled (stall_steps 0: never).
+  // Folded past stall_fold_deg, within stall_move_fraction of the mesh
+  // spacing (every point) of a state it passed at least stall_steps accepted
+  // steps before, folded or not, and with a residual above half of that
+  // state's, the flow has stalled (stall_steps 0: never).
   double stall_fold_deg = 120.0;
   int stall_steps = 20;
   double stall_move_fraction = 0.25;
@@ -37,15 +44,18 @@ class DeadEndWatch {
   const char* reason() const { return reason_; }
 
  private:
-  bool stalled(const Eigen::Matrix3Xd& x, double residual_n);
+  // True if the flow is back near a state of history_ at least stall_steps old.
+  bool returned(const Eigen::Matrix3Xd& x, double residual_n) const;
 
   const Mesh* mesh_;
   DeadEndWatchOptions options_;
-  // The positions of the last stall_steps + 1 folded steps, oldest first,
-  // and the best residual since it last halved (steps_since_best ago).
-  std::deque<Eigen::Matrix3Xd> window_;
-  double best_residual_ = 0.0;
-  int steps_since_best_ = 0;
+  struct Passed {
+    Eigen::Matrix3Xd x;
+    double residual_n;
+  };
+  // Every accepted step's positions and residual, oldest first (at most
+  // kMaxHistory: a planner's settle budget is smaller).
+  std::deque<Passed> history_;
   const char* reason_ = "";
 };
 

@@ -59,10 +59,10 @@ struct SimulatorOptions {
   // Planners set it: such a settle is a dead end.
   bool refuse_folded = false;
   double refuse_fold_deg = 150.0;
-  // With refuse_folded, a flow that stays folded past stall_fold_deg for
-  // refuse_stall_steps accepted steps, neither moving any point more than a
-  // quarter of the mesh spacing, net, nor halving its residual, is a dead end
-  // too (sim/dead_end_watch.h); 0 steps: no such limit.
+  // With refuse_folded, a flow folded past stall_fold_deg that comes back
+  // within a quarter of the mesh spacing of a state it passed at least
+  // refuse_stall_steps accepted steps before, its residual not halved since,
+  // is a dead end too (sim/dead_end_watch.h); 0 steps: no such limit.
   double stall_fold_deg = 120.0;
   int refuse_stall_steps = 20;
   // Effects beyond the baseline, by registry name, and their parameter
