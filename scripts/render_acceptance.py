@@ -11,7 +11,12 @@ starts hapticjam-server on it, runs `hapticjam remote render --json` and
 reads the true surface afterwards.
 
   scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...]
-                               [--corrections targets,model,both] [--planner NAME] [--device-segments P]
+                               [--goals ridge,...,PATH] [--corrections targets,model,both] [--planner NAME]
+                               [--device-segments P]
+
+A goal that is a path (../shared/data/dem/volcano_maunga_whau.csv) is rendered
+as the CLI takes it, at the default relief; its true-surface MAE is against
+the goal at the planner's mesh points that `remote render --out` writes.
 
 Besides the table, one line per run lists the MAE and r of every iteration,
 its planning and fitting seconds and the model fitted last (correction
@@ -140,8 +145,15 @@ def start(argv, pattern, log):
     raise RuntimeError(f"{argv[0]} did not start: " + open(log + ".err").read())
 
 
+def read_points(path):
+    """A frame CSV written by `remote render --out` (goal.csv): row i of the mesh first."""
+    return [[float(v) for v in line.split(",")] for line in open(path) if line.strip()]
+
+
 def run_case(build, work, case, size, goal_name, commands, iterations, noise, gain, planner, correction,
-             device_segments=8):
+             device_segments=8, goal_path=None):
+    """One render. With goal_path, the goal is that file as the CLI takes it (a shared DEM or mesh at
+    the default relief); otherwise the emulator makes it from `commands` and it is rendered in absolute mm."""
     rows, cols = size
     params = os.path.join(work, "device.json")
     with open(params, "w") as f:
@@ -154,14 +166,17 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
     server = None
     try:
         line = Line(port)
-        for c in commands:
-            line.request(c)
-        goal = at_mesh_points(line.request("truth"), rows, cols, 4)
-        line.request("vent")
-        goal_file = os.path.join(work, f"{goal_name}.csv")
-        with open(goal_file, "w") as f:
-            for row in reversed(goal):
-                f.write(",".join(repr(z) for z in row) + "\n")
+        if goal_path:
+            goal_file, heights = goal_path, []
+        else:
+            for c in commands:
+                line.request(c)
+            goal = at_mesh_points(line.request("truth"), rows, cols, 4)
+            line.request("vent")
+            goal_file, heights = os.path.join(work, f"{goal_name}.csv"), ["--heights", "absolute"]
+            with open(goal_file, "w") as f:
+                for row in reversed(goal):
+                    f.write(",".join(repr(z) for z in row) + "\n")
         db = os.path.join(work, "queue.db")
         for suffix in ("", "-wal", "-shm", ".lock"):
             if os.path.exists(db + suffix):
@@ -179,8 +194,8 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
             time.sleep(0.1)
         started = time.time()
         render = subprocess.run([cli, "remote", "render", goal_file, "--rows", str(rows), "--cols", str(cols),
-                                 "--segments", "4", "--iterations", str(iterations), "--heights", "absolute",
-                                 "--json", "--server", address] + (["--gain", str(gain)] if gain else [])
+                                 "--segments", "4", "--iterations", str(iterations), "--json", "--server", address,
+                                 "--out", os.path.join(work, "render")] + heights + (["--gain", str(gain)] if gain else [])
                                 + (["--planner", planner] if planner else [])
                                 + (["--correction", correction] if correction else []), capture_output=True, text=True)
         seconds = time.time() - started
@@ -189,6 +204,8 @@ def run_case(build, work, case, size, goal_name, commands, iterations, noise, ga
         lines = [json.loads(s) for s in render.stdout.splitlines() if s.strip()]
         truth = at_mesh_points(line.request("truth"), rows, cols, 4)
         line.close()
+        if goal_path:
+            goal = read_points(os.path.join(work, "render", "goal.csv"))
         return {"iterations": lines[:-1], "result": lines[-1]["result"], "true_mae_mm": mae(goal, truth),
                 "seconds": seconds}
     finally:
@@ -222,7 +239,9 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--sizes", default="3x4,6x8")
     ap.add_argument("--cases", default=",".join(CASES))
-    ap.add_argument("--goals", default="ridge,terrace,saddle")
+    ap.add_argument("--goals", default="ridge,terrace,saddle",
+                    help="device-made goals (ridge, terrace, saddle) and goal files (a path: a DEM or mesh, "
+                         "rendered at the default relief)")
     ap.add_argument("--iterations", type=int, default=5)
     ap.add_argument("--planner", default="", help="the server's planner for each iteration (default: the server's)")
     ap.add_argument("--noise-mm", type=float, default=1.0)
@@ -242,12 +261,16 @@ def main():
         for case in args.cases.split(","):
             for goal_name in args.goals.split(","):
                 for correction in args.corrections.split(","):
+                    goal_path = goal_name if os.sep in goal_name else None
+                    if goal_path:
+                        goal_name = os.path.splitext(os.path.basename(goal_path))[0]
                     label = f"{size_text} {case} {goal_name} {correction}"
                     with tempfile.TemporaryDirectory(prefix="hj_render_") as work:
                         try:
-                            run = run_case(args.build, work, case, size, goal_name, sequences(*size)[goal_name],
+                            commands = None if goal_path else sequences(*size)[goal_name]
+                            run = run_case(args.build, work, case, size, goal_name, commands,
                                            args.iterations, args.noise_mm, args.gain, args.planner, correction,
-                                           args.device_segments)
+                                           args.device_segments, goal_path)
                         except RuntimeError as e:
                             print(f"| {size_text} | {case} | {goal_name} | {correction} | failed: {e} |||||||",
                                   flush=True)
