@@ -134,6 +134,7 @@ class RenderRun {
         best_mae_ = mae;
         result.set_best_iteration(i);
         *result.mutable_error() = it.error();
+        best_steps_ = last_steps_;
       }
       const bool last = i == setup_.iterations;
       if (!improved && i > 1) stop = "the error stopped falling (iteration " + std::to_string(i) + ")";
@@ -142,8 +143,9 @@ class RenderRun {
       emit_iteration(std::move(it));
       if (stopping) break;
     }
-    if (fits_model(setup_.correction)) *result.mutable_model() = last_model_;
     result.set_stop_reason(stop);
+    if (result.best_iteration() > 0 && result.best_iteration() != result.iterations()) leave_at_best(result);
+    if (fits_model(setup_.correction)) *result.mutable_model() = last_model_;
     result.set_seconds(seconds_since(start));
     return result;
   }
@@ -252,6 +254,41 @@ class RenderRun {
     }
   }
 
+  // The device holds what it ran last; a render ends with it showing the
+  // best run's surface, so when a later run was worse the best run's steps
+  // run again. The repeat's error against the goal is reported beside the
+  // best's (the camera's noise differs; the surface is the same). A device
+  // that refuses the repeat leaves the render's figures as they are, and
+  // the stop reason says so.
+  void leave_at_best(v1::RenderResult& result) {
+    const int best = result.best_iteration();
+    progress(result.iterations(), 1.0, "running iteration " + std::to_string(best) + "'s steps again: the best run");
+    const v1::Job job = run_on_device(best, best_steps_, " again (the best run)");
+    result.set_best_again_job_id(job.id());
+    log_event("render_best_again", {{"job", job.id()}, {"iteration", best}});
+    if (job.state() == v1::JOB_STATE_FAILED) {
+      result.set_stop_reason(result.stop_reason() + "; the device refused the best run's steps again (job " +
+                             std::to_string(job.id()) + ": " + job.error() + ")");
+      return;
+    }
+    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2) {
+      const bool cancelled = job.state() == v1::JOB_STATE_CANCELLED && hooks_.cancelled();
+      throw ServiceError(cancelled ? StatusCode::CANCELLED : StatusCode::ABORTED,
+                         "running the best iteration (" + std::to_string(best) + ") again: device job " +
+                             std::to_string(job.id()) + " ended " + v1::JobState_Name(job.state()) +
+                             (job.error().empty() ? std::string() : ": " + job.error()));
+    }
+    const v1::CaptureFrame& capture = job.captures(job.captures_size() - 1);
+    const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame_heights(capture), frame_grid(capture.grid()));
+    v1::CameraPlane camera;
+    const Eigen::MatrixXd measured = calibrated(best, seen, job.captures(0), &camera);
+    try {
+      error_to_proto(height_error(setup_.goal_mm, measured), result.mutable_best_again_error());
+    } catch (const std::invalid_argument& e) {
+      throw ServiceError(StatusCode::ABORTED, "running the best iteration again: " + std::string(e.what()));
+    }
+  }
+
   // The device could not complete a step its model settles (a device is
   // not the model): the iteration is run again up to the step before, so it
   // ends where the device stood and the correction works on what it made.
@@ -288,6 +325,7 @@ class RenderRun {
     v1::Job job = run_on_device(i, steps, "");
     if (refused_part_way(job, steps.size())) job = rerun_before_refusal(i, job, steps, predicted_state, it);
     it.set_steps_run(int(steps.size()));
+    last_steps_ = steps;
     it.set_device_seconds(seconds_since(device_start));
     it.set_job_id(job.id());
     if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2) {
@@ -448,6 +486,8 @@ class RenderRun {
   // capture and prediction at the mesh points, for screening the next plan.
   double best_mae_ = INFINITY;
   Eigen::MatrixXd previous_targets_, last_measured_, last_predicted_;
+  // The steps the device ran in the last iteration and in the best one.
+  std::vector<Action> last_steps_, best_steps_;
   v1::CaptureGrid last_grid_;
   std::string screen_stop_;
   RenderCalibration calibration_;

@@ -152,6 +152,7 @@ nlohmann::json result_line(const v1::RenderResult& r) {
             {"open_loop_correlation",
              number_or_null(r.open_loop_error().has_correlation(), r.open_loop_error().correlation())},
             {"best_iteration", r.best_iteration()},
+            {"best_again_mae_mm", number_or_null(r.best_again_job_id() != 0, r.best_again_error().mae_mm())},
             {"stop_reason", r.stop_reason()},
             {"model", model_json(r.model())},
             {"seconds", r.seconds()}}}};
@@ -218,6 +219,10 @@ int remote_render(const RemoteRenderArgs& args) {
                 result.error().mae_mm(), result.open_loop_error().mae_mm(), result.error().rmse_mm(),
                 result.error().has_correlation() ? std::to_string(result.error().correlation()).substr(0, 6).c_str() : "-",
                 result.stop_reason().c_str(), result.seconds());
+    if (result.best_again_job_id() != 0)
+      std::printf("the device was left at iteration %d's surface again (job %lld): MAE %.2f mm\n",
+                  result.best_iteration(), static_cast<long long>(result.best_again_job_id()),
+                  result.best_again_error().mae_mm());
   }
   return 0;
 }
