@@ -254,6 +254,15 @@ class RenderRun {
     }
   }
 
+  // A device job that did not end with its captures ends the render:
+  // CANCELLED if the caller cancelled it, else ABORTED, naming the job and how it ended.
+  [[noreturn]] void throw_unfinished(const v1::Job& job, const std::string& what) const {
+    const bool cancelled = job.state() == v1::JOB_STATE_CANCELLED && hooks_.cancelled();
+    throw ServiceError(cancelled ? StatusCode::CANCELLED : StatusCode::ABORTED,
+                       what + ": device job " + std::to_string(job.id()) + " ended " + v1::JobState_Name(job.state()) +
+                           (job.error().empty() ? std::string() : ": " + job.error()));
+  }
+
   // The device holds what it ran last; a render ends with it showing the
   // best run's surface, so when a later run was worse the best run's steps
   // run again. The repeat's error against the goal is reported beside the
@@ -271,13 +280,8 @@ class RenderRun {
                              std::to_string(job.id()) + ": " + job.error() + ")");
       return;
     }
-    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2) {
-      const bool cancelled = job.state() == v1::JOB_STATE_CANCELLED && hooks_.cancelled();
-      throw ServiceError(cancelled ? StatusCode::CANCELLED : StatusCode::ABORTED,
-                         "running the best iteration (" + std::to_string(best) + ") again: device job " +
-                             std::to_string(job.id()) + " ended " + v1::JobState_Name(job.state()) +
-                             (job.error().empty() ? std::string() : ": " + job.error()));
-    }
+    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2)
+      throw_unfinished(job, "running the best iteration (" + std::to_string(best) + ") again");
     const v1::CaptureFrame& capture = job.captures(job.captures_size() - 1);
     const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame_heights(capture), frame_grid(capture.grid()));
     v1::CameraPlane camera;
@@ -328,13 +332,8 @@ class RenderRun {
     last_steps_ = steps;
     it.set_device_seconds(seconds_since(device_start));
     it.set_job_id(job.id());
-    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2) {
-      const bool cancelled = job.state() == v1::JOB_STATE_CANCELLED && hooks_.cancelled();
-      throw ServiceError(cancelled ? StatusCode::CANCELLED : StatusCode::ABORTED,
-                         "render iteration " + std::to_string(i) + ": device job " + std::to_string(job.id()) +
-                             " ended " + v1::JobState_Name(job.state()) +
-                             (job.error().empty() ? std::string() : ": " + job.error()));
-    }
+    if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2)
+      throw_unfinished(job, "render iteration " + std::to_string(i));
     *it.mutable_rest_capture() = job.captures(0);
     *it.mutable_capture() = job.captures(job.captures_size() - 1);
 
