@@ -102,7 +102,8 @@ class Line:
 
 
 def at_mesh_points(payload, rows, cols, p, cell_mm=38.0):
-    """A `frame` payload bilinearly sampled at the rest points (row i along +y)."""
+    """A `frame` payload bilinearly sampled at the rest points (row i along +y); an empty
+    sample on the clamped edge is its height, 0."""
     words = payload.split(" ")
     nx, ny = int(words[1]), int(words[2])
     x0, y0, dx, dy = map(float, words[3:7])
@@ -122,7 +123,10 @@ def at_mesh_points(payload, rows, cols, p, cell_mm=38.0):
                     k = (fx if ddx else 1 - fx) * (fy if ddy else 1 - fy)
                     if z == z and k > 0:
                         s, wt = s + k * z, wt + k
-            row.append(s / wt if wt > 0 else float("nan"))
+            on_edge = i in (0, rows * p) or j in (0, cols * p)
+            # The clamped edge is at 0; a camera sample beside it can be empty where the
+            # membrane has moved inward (the frame's highest-triangle rule finds nothing there).
+            row.append(s / wt if wt > 0 else 0.0 if on_edge else float("nan"))
         out.append(row)
     return out
 
