@@ -6,12 +6,12 @@
 #include <sstream>
 
 #include "calib/measurement_effects.h"
-#include "calib/rasterize.h"
 #include "json_log.h"
 #include "metrics/correction_screen.h"
 #include "metrics/height_error.h"
 #include "plan/planner.h"
 #include "render_calibration.h"
+#include "render_frames.h"
 #include "service_error.h"
 #include "sim/settle_report.h"
 #include "sim/simulator.h"
@@ -29,45 +29,6 @@ namespace {
 constexpr double kMinImprovement = 0.02;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-void add_heights(const Eigen::MatrixXd& m, google::protobuf::RepeatedField<double>* out) {
-  out->Reserve(int(m.size()));
-  for (int i = 0; i < m.rows(); ++i)
-    for (int j = 0; j < m.cols(); ++j) out->Add(m(i, j));
-}
-
-void error_to_proto(const HeightError& e, v1::SurfaceError* out) {
-  out->set_mae_mm(e.mae_mm);
-  out->set_rmse_mm(e.rmse_mm);
-  if (e.correlation.value) out->set_correlation(*e.correlation.value);
-  out->set_points(e.points);
-}
-
-FrameGrid frame_grid(const v1::CaptureGrid& g) { return {g.nx(), g.ny(), g.x0_mm(), g.y0_mm(), g.dx_mm(), g.dy_mm()}; }
-
-Eigen::MatrixXd frame_heights(const v1::CaptureFrame& frame) {
-  const int nx = frame.grid().nx(), ny = frame.grid().ny();
-  if (nx < 1 || ny < 1 || frame.heights_mm_size() != nx * ny)
-    throw ServiceError(StatusCode::INTERNAL, "the device returned a capture of " +
-                                                 std::to_string(frame.heights_mm_size()) + " samples for a grid of " +
-                                                 std::to_string(nx) + " x " + std::to_string(ny));
-  Eigen::MatrixXd out(ny, nx);
-  for (int iy = 0; iy < ny; ++iy)
-    for (int ix = 0; ix < nx; ++ix) out(iy, ix) = frame.heights_mm(iy * nx + ix);
-  return out;
-}
-
-SessionGrid session_grid(const v1::CaptureGrid& g) {
-  SessionGrid grid;
-  grid.nx = g.nx(), grid.ny = g.ny(), grid.x0_mm = g.x0_mm(), grid.y0_mm = g.y0_mm();
-  grid.dx_mm = g.dx_mm(), grid.dy_mm = g.dy_mm();
-  return grid;
-}
-
-// The predicted surface as the camera would see it at the rest points: like with like.
-Eigen::MatrixXd predicted_at_rest_points(const Mesh& mesh, const Eigen::Matrix3Xd& x, const v1::CaptureGrid& g) {
-  return frame_at_rest_points(mesh, rasterize_top_view(mesh, x, session_grid(g)), frame_grid(g));
-}
 
 // A render job's steps: the capture at rest, the actions, the capture.
 // How many actions it carried out.
@@ -98,11 +59,6 @@ ModelParams model_of(const ArrayConfig& array) {
   return out;
 }
 
-void camera_to_proto(const CameraPlane& plane, const std::string& source, v1::CameraPlane* out) {
-  out->set_tilt_x_mrad(plane.tilt_x_mrad), out->set_tilt_y_mrad(plane.tilt_y_mrad);
-  out->set_offset_mm(plane.offset_mm), out->set_points(plane.points);
-  out->set_source(source);
-}
 
 class RenderRun {
  public:
@@ -283,9 +239,8 @@ class RenderRun {
     if (job.state() != v1::JOB_STATE_DONE || job.captures_size() < 2)
       throw_unfinished(job, "running the best iteration (" + std::to_string(best) + ") again");
     const v1::CaptureFrame& capture = job.captures(job.captures_size() - 1);
-    const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame_heights(capture), frame_grid(capture.grid()));
     v1::CameraPlane camera;
-    const Eigen::MatrixXd measured = calibrated(best, seen, job.captures(0), &camera);
+    const Eigen::MatrixXd measured = calibrated(best, frame_heights(capture), capture.grid(), job.captures(0), &camera);
     try {
       error_to_proto(height_error(setup_.goal_mm, measured), result.mutable_best_again_error());
     } catch (const std::invalid_argument& e) {
@@ -339,8 +294,7 @@ class RenderRun {
 
     const Eigen::MatrixXd frame = frame_heights(it.capture());
     if (fits_model(setup_.correction)) fit_model(i, steps, frame, it);
-    const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame, frame_grid(it.capture().grid()));
-    const Eigen::MatrixXd measured = calibrated(i, seen, it.rest_capture(), it.mutable_camera());
+    const Eigen::MatrixXd measured = calibrated(i, frame, it.capture().grid(), it.rest_capture(), it.mutable_camera());
     const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, predicted_state.x, it.capture().grid());
     it.set_point_rows(mesh_.point_rows()), it.set_point_cols(mesh_.point_cols());
     add_heights(measured, it.mutable_measured_heights_mm());
@@ -417,10 +371,13 @@ class RenderRun {
     log_event("render_fit", {{"iteration", i}, {"rmse_mm", it.model().rmse_mm()}, {"seconds", it.fitting_seconds()}});
   }
 
-  // The capture with the camera's plane taken out: the fitted sensor_tilt
-  // where the model is fitted, else the plane fitted on the clamped edge in
-  // the capture at rest (a shaped membrane can bulge over its edge).
-  Eigen::MatrixXd calibrated(int i, const Eigen::MatrixXd& seen, const v1::CaptureFrame& rest, v1::CameraPlane* out) {
+  // A capture (its heights on its grid) at the mesh points, with the
+  // camera's plane taken out: the fitted sensor_tilt where the model is
+  // fitted, else the plane fitted on the clamped edge in the capture at
+  // rest (a shaped membrane can bulge over its edge).
+  Eigen::MatrixXd calibrated(int i, const Eigen::MatrixXd& frame, const v1::CaptureGrid& grid,
+                             const v1::CaptureFrame& rest, v1::CameraPlane* out) {
+    const Eigen::MatrixXd seen = frame_at_rest_points(mesh_, frame, frame_grid(grid));
     if (setup_.keep_camera_plane) {
       camera_to_proto({}, "none", out);
       return seen;
