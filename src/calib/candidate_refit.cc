@@ -165,4 +165,31 @@ void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::ve
   }
 }
 
+bool refit_from_rebased_current(Selection& s, CandidateFit& c) {
+  const auto parameters = fit_parameters(c.effects);
+  ModelParams start = with_effects(s.current.params, c.effects);
+  for (const FitParameter& p : parameters)
+    if (!p.surface && p.effect == c.added) set_parameter_value(start, p, parameter_value(c.fit.params, p));
+  const std::string stage = "candidate " + c.added + " from the refitted current model";
+  try {
+    LeastSquaresResult again = fit_least_squares(
+        s.dataset, start, parameters, s.options.fit.least_squares, [&](int iteration, int max_iterations, double rmse) {
+          if (s.progress) s.progress(stage, iteration, max_iterations, rmse_detail(rmse));
+        });
+    if (!(again.sum_sq_mm2 < c.fit.sum_sq_mm2)) return false;
+    char note[200];
+    std::snprintf(note, sizeof note, "refitted from the refitted current model: RMSE %.4f -> %.4f mm",
+                  c.fit.rmse_mm, again.rmse_mm);
+    c.fit = std::move(again);
+    if (s.progress) s.progress("cross-validation", 0, 1, c.added);
+    c.heldout_rmse_mm = cross_validate(s.dataset, parameters, c.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
+    c.recheck_note = note;
+    return true;
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
+  } catch (const std::exception&) {
+    return false;  // its first fit stands
+  }
+}
+
 }  // namespace hj

@@ -17,4 +17,13 @@ namespace hj {
 // out.skipped.
 void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits);
 
+// After the current model was refitted to a better optimum (like with
+// like), a candidate fitted from the old one may end above it, though a
+// model that extends the current one can always match it: its fit stopped
+// in the old optimum's basin. It is refitted from the new optimum with its
+// effect where its fit left it; true (c's fit, held-out RMSE and note
+// replaced) if that fits better. Its delta BIC and significance are the
+// caller's to redo.
+bool refit_from_rebased_current(Selection& s, CandidateFit& c);
+
 }  // namespace hj

@@ -275,12 +275,16 @@ void recheck_like_with_like(Selection& s, int round, std::vector<CandidateFit>& 
     ++refits;
     const std::string why = "not significant against the current model refitted from " + next->added + "'s optimum";
     // Every refitted candidate's delta BIC is against the model it extends,
-    // so against this fit now; one that was not significant cannot become
-    // so against a better fit.
+    // so against this fit now. One that fits worse than it stopped short
+    // and is refitted from it; any other that was not significant cannot
+    // become so against a better fit.
     for (CandidateFit& c : fits) {
       if (c.screened_out) continue;  // predicted figures: kept as predicted
+      const bool refitted = c.fit.sum_sq_mm2 > s.current.sum_sq_mm2 && refit_from_rebased_current(s, c);
       c.delta_bic = bic(c.fit) - bic(s.current);
-      if (c.significant) {
+      if (refitted) {
+        c.significant = is_significant(c, s.current, s.current_heldout, s.options);
+      } else if (c.significant) {
         c.significant = is_significant(c, s.current, s.current_heldout, s.options);
         if (!c.significant) c.recheck_note = why;
       }
