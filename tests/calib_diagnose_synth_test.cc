@@ -45,8 +45,10 @@ DiagnoseOptions three_candidates() {
 // always match it: none of the first round's refits ends above the
 // baseline (to the least squares' convergence).
 void expect_no_refit_above_the_baseline(const Diagnosis& result) {
-  for (const CandidateFit& c : result.ranking)
-    if (!c.screened_out) EXPECT_LE(c.fit.rmse_mm, 1.001 * result.baseline.joint.rmse_mm) << c.added;
+  for (const CandidateFit& c : result.ranking) {
+    if (c.screened_out) continue;
+    EXPECT_LE(c.fit.rmse_mm, 1.001 * result.baseline.joint.rmse_mm) << c.added;
+  }
 }
 
 TEST(CalibDiagnoseSynth, FindsTheCameraTiltAndFitsIt) {

@@ -113,9 +113,7 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
   // Warm start: the current model's optimum, the new effect where the scan
   // found it best, or where the best short fit over its range ended.
   try {
-    const LeastSquaresProgress fit_progress = [&](int iteration, int max_iterations, double rmse) {
-      if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
-    };
+    const LeastSquaresProgress fit_progress = least_squares_progress(progress, stage);
     if (s.options.multi_start_before_refit) start_from_best_of_range(s.dataset, s.current.params, s.options, progress, c);
     c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options, fit_progress);
     if (!s.options.multi_start_before_refit) refit_over_range_if_unexplained(s, parameters, fit_progress, c);
@@ -170,12 +168,10 @@ bool refit_from_rebased_current(Selection& s, CandidateFit& c) {
   ModelParams start = with_effects(s.current.params, c.effects);
   for (const FitParameter& p : parameters)
     if (!p.surface && p.effect == c.added) set_parameter_value(start, p, parameter_value(c.fit.params, p));
-  const std::string stage = "candidate " + c.added + " from the refitted current model";
   try {
-    LeastSquaresResult again = fit_least_squares(
-        s.dataset, start, parameters, s.options.fit.least_squares, [&](int iteration, int max_iterations, double rmse) {
-          if (s.progress) s.progress(stage, iteration, max_iterations, rmse_detail(rmse));
-        });
+    LeastSquaresResult again =
+        fit_least_squares(s.dataset, start, parameters, s.options.fit.least_squares,
+                          least_squares_progress(s.progress, "candidate " + c.added + " from the refitted current model"));
     if (!(again.sum_sq_mm2 < c.fit.sum_sq_mm2)) return false;
     char note[200];
     std::snprintf(note, sizeof note, "refitted from the refitted current model: RMSE %.4f -> %.4f mm",

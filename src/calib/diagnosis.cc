@@ -50,10 +50,8 @@ bool converge(const Dataset& dataset, const std::vector<FitParameter>& parameter
     LeastSquaresOptions longer = options.fit.least_squares;
     longer.max_iterations = more;
     longer.function_tolerance *= 0.1;
-    LeastSquaresResult next = fit_least_squares(dataset, fit.params, parameters, longer,
-                                                [&](int iteration, int max_iterations, double rmse) {
-                                                  if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
-                                                });
+    LeastSquaresResult next =
+        fit_least_squares(dataset, fit.params, parameters, longer, least_squares_progress(progress, stage));
     if (next.sum_sq_mm2 <= fit.sum_sq_mm2) {  // it starts at the fit's optimum: never worse
       next.iterations += fit.iterations;
       fit = std::move(next);
@@ -93,9 +91,7 @@ bool recheck_current(const Dataset& dataset, const DiagnoseOptions& options, int
   if (progress) progress(stage, 0, options.fit.least_squares.max_iterations, "");
   LikeWithLike check = refit_from_candidate_optimum(
       dataset, current, parameters, c.fit.params, c.added, options.min_fit_gain, options.fit.least_squares,
-      [&](int iteration, int max_iterations, double rmse) {
-        if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
-      });
+      least_squares_progress(progress, stage));
   if (!check.refit) {
     if (progress)
       progress(stage, options.fit.least_squares.max_iterations, options.fit.least_squares.max_iterations,
@@ -282,12 +278,9 @@ void recheck_like_with_like(Selection& s, int round, std::vector<CandidateFit>& 
       if (c.screened_out) continue;  // predicted figures: kept as predicted
       const bool refitted = c.fit.sum_sq_mm2 > s.current.sum_sq_mm2 && refit_from_rebased_current(s, c);
       c.delta_bic = bic(c.fit) - bic(s.current);
-      if (refitted) {
-        c.significant = is_significant(c, s.current, s.current_heldout, s.options);
-      } else if (c.significant) {
-        c.significant = is_significant(c, s.current, s.current_heldout, s.options);
-        if (!c.significant) c.recheck_note = why;
-      }
+      if (!refitted && !c.significant) continue;
+      c.significant = is_significant(c, s.current, s.current_heldout, s.options);
+      if (!refitted && !c.significant) c.recheck_note = why;
     }
     rank(fits);
   }

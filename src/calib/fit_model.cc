@@ -31,9 +31,8 @@ void refine_on_bare_captures(const Dataset& dataset, const std::vector<FitParame
   if (bare.sessions.empty() || surface.empty()) return;
   try {
     const LeastSquaresResult r =
-        fit_least_squares(bare, out.initial, surface, options.least_squares, [&](int iteration, int max, double rmse) {
-          if (progress) progress("least squares on the bare captures", iteration, max, rmse_detail(rmse));
-        });
+        fit_least_squares(bare, out.initial, surface, options.least_squares,
+                          least_squares_progress(progress, "least squares on the bare captures"));
     out.initial = r.params;
     out.bare_rmse_mm = r.rmse_mm;
   } catch (const SettleInterrupted&) {
@@ -49,6 +48,12 @@ std::string rmse_detail(double rmse_mm) {
   char detail[64];
   std::snprintf(detail, sizeof detail, "RMSE %.3f mm", rmse_mm);
   return detail;
+}
+
+LeastSquaresProgress least_squares_progress(const FitProgress& progress, const std::string& stage) {
+  return [progress, stage](int iteration, int max_iterations, double rmse_mm) {
+    if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse_mm));
+  };
 }
 
 std::optional<double> rmse_of_detail(const std::string& detail) {
@@ -68,9 +73,7 @@ LeastSquaresResult probe_and_refit(const Dataset& dataset, const std::vector<Fit
     if (!probe.moved) break;
     const std::string stage = "least squares from the probe";
     LeastSquaresResult next = fit_least_squares(dataset, probe.best, parameters, options.least_squares,
-                                                [&](int iteration, int max_iterations, double rmse) {
-                                                  if (progress) progress(stage, iteration, max_iterations, rmse_detail(rmse));
-                                                });
+                                                least_squares_progress(progress, stage));
     if (!(next.sum_sq_mm2 < fit.sum_sq_mm2)) break;
     char text[320];
     std::snprintf(text, sizeof text,
@@ -116,9 +119,7 @@ FitReport fit_model(const Dataset& dataset, const ModelParams& start, const std:
     }
   }
   out.joint = fit_least_squares(dataset, out.initial, parameters, options.least_squares,
-                                [&](int iteration, int max_iterations, double rmse) {
-                                  if (progress) progress("least squares", iteration, max_iterations, rmse_detail(rmse));
-                                });
+                                least_squares_progress(progress, "least squares"));
   out.joint = probe_and_refit(dataset, parameters, options, progress, std::move(out.joint), out.probe_notes);
   if (options.profile_loose)
     profile_loose_parameters(dataset, parameters, options.least_squares, options.profile, out.joint,

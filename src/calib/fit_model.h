@@ -61,6 +61,9 @@ using FitProgress = std::function<void(const std::string& stage, int done, int t
 // progress (the server) can report it as a number.
 std::string rmse_detail(double rmse_mm);
 std::optional<double> rmse_of_detail(const std::string& detail);
+// A least-squares fit's iterations reported to `progress` as `stage`, each
+// with its RMSE (rmse_detail).
+LeastSquaresProgress least_squares_progress(const FitProgress& progress, const std::string& stage);
 
 // A converged least-squares fit may sit beside a clearly better basin
 // (optimum_probe.h): fits again from the best probed point while one is, up
