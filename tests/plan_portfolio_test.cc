@@ -90,6 +90,34 @@ TEST(Portfolio, StopsTheOtherStrategiesAtItsTimeBudget) {
   EXPECT_LT((best.final_state.x - paper.final_state.x).cwiseAbs().maxCoeff(), 1e-9);
 }
 
+// A planner stopped in the middle hands back its plan so far, and that
+// plan replays from rest to the state it reports, whenever it was stopped.
+TEST(Portfolio, AStoppedStrategyHandsBackAPlanThatReplays) {
+  const PlanRequest request = volcano_request({3, 4, 0.038, 4});
+  // Stopped while the rest state settles, a planner has no plan yet.
+  int rest_polls = 0;
+  SimulatorOptions counting = simulator_options(request, {});
+  counting.interrupted = [&] { return ++rest_polls < 0; };
+  Simulator(request.geometry, request.params, counting);
+  int all_polls = 0;
+  PlanCallbacks counted;
+  counted.cancelled = [&] { return ++all_polls < 0; };
+  make_planner("from-above")->plan(request, counted);
+  for (double fraction : {0.0, 0.2, 0.5, 0.8, 0.95}) {
+    const int polls_allowed = rest_polls + int(fraction * (all_polls - rest_polls));
+    int polls = 0;
+    PlanCallbacks callbacks;
+    callbacks.cancelled = [&] { return ++polls > polls_allowed; };
+    try {
+      make_planner("from-above")->plan(request, callbacks);
+      ADD_FAILURE() << "from-above finished within " << polls_allowed << " polls";
+    } catch (const PlanCancelled& stopped) {
+      ASSERT_NE(stopped.partial(), nullptr) << polls_allowed;
+      EXPECT_LT(replay_gap_m(request, *stopped.partial()), 1e-5) << polls_allowed;
+    }
+  }
+}
+
 TEST(Portfolio, RefusesABadTimeBudget) {
   for (double ratio : {-1.0, std::nan(""), double(INFINITY)}) {
     PortfolioOptions options;

@@ -74,12 +74,20 @@ Simulator start_simulator(const PlanRequest& request, const PlanCallbacks& callb
   }
 }
 
+namespace {
+PlanCancelled cancelled_with_plan_so_far(const Simulator& sim, const PlanResult& result) {
+  PlanResult so_far = result;
+  so_far.final_state = sim.state();
+  return PlanCancelled(std::move(so_far));
+}
+}  // namespace
+
 void apply_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks) {
-  if (callbacks.cancelled && callbacks.cancelled()) throw PlanCancelled();
+  if (callbacks.cancelled && callbacks.cancelled()) throw cancelled_with_plan_so_far(sim, result);
   try {
     sim.apply(action);
   } catch (const SettleInterrupted&) {
-    throw PlanCancelled();
+    throw cancelled_with_plan_so_far(sim, result);
   }
   result.steps.push_back(action);
   if (callbacks.snapshot) callbacks.snapshot(sim.state());

@@ -62,6 +62,15 @@ struct PlanResult {
 class PlanCancelled : public std::runtime_error {
  public:
   PlanCancelled() : std::runtime_error("planning was cancelled") {}
+  // The plan so far when the planner was stopped between or inside its
+  // actions: its steps replay from rest to its final_state, a settled
+  // equilibrium. A caller that stopped a planner at a time budget may keep it.
+  explicit PlanCancelled(PlanResult so_far)
+      : std::runtime_error("planning was cancelled"), partial_(std::make_shared<PlanResult>(std::move(so_far))) {}
+  const PlanResult* partial() const { return partial_.get(); }
+
+ private:
+  std::shared_ptr<const PlanResult> partial_;  // shared: exceptions are copied
 };
 
 class Planner {
@@ -92,7 +101,8 @@ constexpr int kPlannerSettleSteps = 150;
 Simulator start_simulator(const PlanRequest& request, const PlanCallbacks& callbacks);
 
 // Applies one planned action: cancellation checked first, a cancelled
-// settle thrown as PlanCancelled, the action recorded in result.steps and
+// settle thrown as PlanCancelled carrying the plan so far (result with the
+// simulator's state, which a cancelled settle leaves as it was), the action recorded in result.steps and
 // the state sent to callbacks.snapshot.
 void apply_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks);
 

@@ -23,6 +23,7 @@ struct StrategyOutcome {
   std::optional<PlanResult> result;
   double score = -INFINITY;
   double seconds = 0.0;
+  bool stopped_at_budget = false;  // result is the plan it had then
   std::string error;
 };
 
@@ -119,10 +120,16 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
     try {
       out.result = list[k].second->plan(request, own);
       out.score = plan_score(request, mesh, out.result->final_state);
-    } catch (const PlanCancelled&) {
+    } catch (const PlanCancelled& stopped) {
       if (user_cancelled()) {
         const std::lock_guard<std::mutex> lock(mutex);
         cancelled = std::current_exception();
+      } else if (stopped.partial()) {
+        // Stopped at the budget: its plan so far is a plan too, and may
+        // already beat Algorithm 2's (an anytime strategy).
+        out.result = *stopped.partial();
+        out.score = plan_score(request, mesh, out.result->final_state);
+        out.stopped_at_budget = true;
       }
       out.error = budget.describe();
     } catch (const std::exception& e) {
@@ -150,8 +157,8 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
   for (std::size_t k = 0; k < n; ++k) {
     char line[200];
     if (outcomes[k].result)
-      std::snprintf(line, sizeof line, " %s %.4f in %.3g s", list[k].first.c_str(), outcomes[k].score,
-                    outcomes[k].seconds);
+      std::snprintf(line, sizeof line, " %s %.4f in %.3g s%s", list[k].first.c_str(), outcomes[k].score,
+                    outcomes[k].seconds, outcomes[k].stopped_at_budget ? " (its plan so far, stopped at the time budget)" : "");
     else
       std::snprintf(line, sizeof line, " %s failed (%.100s)", list[k].first.c_str(), outcomes[k].error.c_str());
     note += (k ? ";" : "") + std::string(line);

@@ -19,7 +19,8 @@ struct PortfolioOptions {
   int threads = 0;
   // Once Algorithm 2 has finished in T seconds, the other strategies get
   // until max_time_ratio * T (at least min_budget_s) from the start; one still
-  // running then is stopped and left out. 0: no limit.
+  // running then is stopped, and the plan it had so far competes with the
+  // finished ones. 0: no limit.
   double max_time_ratio = 5.0;
   double min_budget_s = 0.0;
   // Throws std::invalid_argument naming the bad field.
