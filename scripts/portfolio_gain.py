@@ -7,7 +7,8 @@ Rows are matched by goal, size and order (the Luxembourg CSV and TIFF are
 both "luxembourg_elev"). Prints the mean correlation of each and the mean,
 smallest and largest gain, the plans where the portfolio is more than 0.01
 below, the portfolio's time over its own Algorithm 2 run's (from its note),
-the strategies it chose, and the mean per size.
+the same against the Algorithm 2 sweep's own rows (both include goal
+resampling and scoring), the strategies it chose, and the mean per size.
 """
 import collections
 import csv
@@ -30,6 +31,8 @@ def main(a2_path, pf_path):
     both = [k for k in pf if k in a2 and a2[k]["status"] == "ok" and pf[k]["status"] == "ok"]
     gain = {k: float(pf[k]["correlation"]) - float(a2[k]["correlation"]) for k in both}
     ratios, chosen, per_size = [], collections.Counter(), collections.defaultdict(list)
+    # Whole rows against whole rows (goal resampling and scoring in both), from the two runs.
+    row_ratios = [float(pf[k]["seconds"]) / max(float(a2[k]["seconds"]), 1e-3) for k in both]
     for k in both:
         m = re.search(r"algorithm2 -?[0-9.]+ in ([0-9.e+-]+) s", pf[k].get("note", ""))
         if m:
@@ -46,7 +49,16 @@ def main(a2_path, pf_path):
     print(f"portfolio more than 0.01 below algorithm2: {len(below)} {below}")
     if ratios:
         print(f"portfolio time / its algorithm2's: median {statistics.median(ratios):.2f}, largest {max(ratios):.2f}")
+    worst = max(zip(row_ratios, both))
+    print(f"portfolio row time / algorithm2 sweep row time: median {statistics.median(row_ratios):.2f}, "
+          f"largest {worst[0]:.2f} ({worst[1][0]} {worst[1][1]}x{worst[1][2]})")
     print("chosen:", ", ".join(f"{name} {n}" for name, n in chosen.most_common()))
+    notes = [pf[k].get("note", "") for k in both]
+    stopped = sum("stopped at the time budget" in n for n in notes)
+    # The chosen strategy's entry in the note says whether it is a plan so far.
+    so_far = sum(any(part.strip().removeprefix("strategies: ").startswith(n.split(";")[0].removeprefix("chose ") + " ")
+                     and "plan so far" in part for part in n.split(";")[1:]) for n in notes)
+    print(f"plans where the budget stopped a strategy: {stopped}; chosen plans that are a stopped strategy's plan so far: {so_far}")
     print("| size | algorithm2 mean r | portfolio mean r |")
     print("|---|---|---|")
     for s in sorted(per_size):
