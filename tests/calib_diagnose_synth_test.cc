@@ -7,6 +7,7 @@
 // whole matrix (every effect, combinations) on demo-baseline's sessions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -106,6 +107,9 @@ TEST(CalibDiagnoseSynth, TheBaselineIsFittedOnUntilItConverges) {
   o.candidates = {"jam_contraction"};
   o.fit.least_squares.max_iterations = 1;  // the paper's start is far from this optimum
   o.max_continuations = 0;
+  // The continuation alone: an optimum probe also moves a fit stopped at its
+  // cap (optimum_probe.h), and here takes it to convergence by itself.
+  o.fit.probe_rounds = 0;
   const Diagnosis cut = diagnose(d, ModelParams{}, o);
   ASSERT_EQ(cut.notes.size(), 1u) << ::testing::PrintToString(cut.notes);
   EXPECT_NE(cut.notes[0].find("baseline: the fit did not converge within 1 iterations"), std::string::npos)
@@ -116,6 +120,25 @@ TEST(CalibDiagnoseSynth, TheBaselineIsFittedOnUntilItConverges) {
   EXPECT_TRUE(finished.baseline.joint.converged);
   EXPECT_LT(finished.baseline.joint.sum_sq_mm2, cut.baseline.joint.sum_sq_mm2);
   EXPECT_LT(finished.baseline.joint.rmse_mm, 1.05 * finished.noise_floor_mm);
+}
+
+// A fit cut off by its iteration cap while still descending is probed like
+// a converged one, and restarted from the better point the probe finds.
+TEST(CalibDiagnoseSynth, AFitStoppedAtItsCapIsProbedAndRestarted) {
+  testing_support::ScratchDir scratch("capped-probe");
+  const Dataset d = synthetic(scratch.path, false);
+  DiagnoseOptions o = three_candidates();
+  o.candidates = {"jam_contraction"};
+  o.fit.least_squares.max_iterations = 1;  // the paper's start is far from this optimum
+  o.max_continuations = 0;
+  const Diagnosis probed = diagnose(d, ModelParams{}, o);
+  EXPECT_TRUE(std::any_of(probed.notes.begin(), probed.notes.end(), [](const std::string& note) {
+    return note.find("stopped at its iteration cap short of a better point") != std::string::npos;
+  })) << ::testing::PrintToString(probed.notes);
+  o.fit.probe_rounds = 0;
+  const Diagnosis cut = diagnose(d, ModelParams{}, o);
+  EXPECT_LT(probed.baseline.joint.sum_sq_mm2, cut.baseline.joint.sum_sq_mm2);
+  EXPECT_LT(probed.baseline.joint.rmse_mm, 1.05 * probed.noise_floor_mm);
 }
 
 // The loophole the control dataset found: a sample the predicted surface

@@ -27,9 +27,9 @@ std::vector<std::string> candidate_effects(const DiagnoseOptions& options) {
 }
 
 // Fits `fit` on from where it stopped, restarting Ceres once with a tighter
-// tolerance (see DiagnoseOptions::max_continuations); says so in notes if
-// it does not converge.
-// True if the fit moved on.
+// tolerance (see DiagnoseOptions::max_continuations), then, if it is still
+// descending at that cap, from the best point of an optimum probe; says so
+// in notes if it does not converge. True if the fit moved on.
 // Without it, a candidate refitted from an optimum the cap cut short gets
 // further down the same valley and is credited with it: on a synthetic
 // camera tilt, jam_creep, which cannot change those frames, lowered the
@@ -57,6 +57,13 @@ bool converge(const Dataset& dataset, const std::vector<FitParameter>& parameter
       fit = std::move(next);
       moved = true;
     }
+  }
+  if (more > 0 && fit.stopped_at_cap) {
+    // Still descending after the continuation: a probe may find the point
+    // far down its valley (one more way of fitting on, so off with them).
+    const double before = fit.sum_sq_mm2;
+    fit = probe_and_refit(dataset, parameters, options.fit, progress, std::move(fit), notes);
+    moved = moved || fit.sum_sq_mm2 < before;
   }
   if (!fit.converged) {
     char note[400];

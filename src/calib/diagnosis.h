@@ -52,8 +52,10 @@ struct DiagnoseOptions {
   bool scan = true;
   // A model the next candidates are judged against (the baseline, a chosen
   // effect) is fitted on from its optimum once more, with a 10x tighter
-  // function tolerance, for up to this many times the cap; one that still
-  // has not converged is reported in Diagnosis::notes. 0: not fitted on.
+  // function tolerance, for up to this many times the cap, and one still
+  // descending then is probed (optimum_probe.h) and fitted on from a better
+  // point; one that still has not converged is reported in
+  // Diagnosis::notes. 0: not fitted on.
   int max_continuations = 2;
   // Candidates are refitted in the order of their predicted RMSE (or, where
   // the screening cannot predict, the RMSE at the scan's best point, where

@@ -66,8 +66,9 @@ std::optional<double> rmse_of_detail(const std::string& detail);
 LeastSquaresProgress least_squares_progress(const FitProgress& progress, const std::string& stage);
 
 // A converged least-squares fit may sit beside a clearly better basin
-// (optimum_probe.h): fits again from the best probed point while one is, up
-// to options.probe_rounds times, and says where from in `notes`.
+// (optimum_probe.h), and one stopped at its iteration cap may still be far
+// up a valley: fits again from the best probed point while one is, up to
+// options.probe_rounds times, and says where from in `notes`.
 LeastSquaresResult probe_and_refit(const Dataset& dataset, const std::vector<FitParameter>& parameters,
                                    const FitOptions& options, const FitProgress& progress, LeastSquaresResult fit,
                                    std::vector<std::string>& notes);

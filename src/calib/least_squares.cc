@@ -336,6 +336,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
     out.iterations = static_cast<int>(summary.iterations.size());
     out.termination = summary.BriefReport();
     out.converged = summary.termination_type == ceres::CONVERGENCE;
+    out.stopped_at_cap = summary.termination_type == ceres::NO_CONVERGENCE;
   }
 
   // The optimum's residuals and Jacobian (cached if Ceres ended on one).

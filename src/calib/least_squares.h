@@ -65,6 +65,8 @@ struct LeastSquaresResult {
   // cap or a failure: a model compared with another must have converged,
   // or the other is credited with its unfinished descent.
   bool converged = false;
+  // Ceres ran out of iterations (still descending), as against converging or failing.
+  bool stopped_at_cap = false;
   // At the optimum, for cross-validation without refitting from scratch:
   // the residuals (n), the Jacobian (n x p) in the scaled variables
   // u = value / scale of the active parameters, and each session's first
