@@ -98,15 +98,22 @@ TEST(CalibDiagnoseSynth, ChoosesNothingWithoutAnEffect) {
   EXPECT_LT(result.baseline.joint.rmse_mm, 1.05 * result.noise_floor_mm);
 }
 
+// One candidate, fits capped at one iteration (the paper's start is far from
+// this optimum) and not fitted on: a baseline cut short.
+DiagnoseOptions cut_short() {
+  DiagnoseOptions o = three_candidates();
+  o.candidates = {"jam_contraction"};
+  o.fit.least_squares.max_iterations = 1;
+  o.max_continuations = 0;
+  return o;
+}
+
 // A baseline cut short by the iteration cap is fitted on before anything
 // is judged against it; one that still has not converged is named.
 TEST(CalibDiagnoseSynth, TheBaselineIsFittedOnUntilItConverges) {
   testing_support::ScratchDir scratch("converge");
   const Dataset d = synthetic(scratch.path, false);
-  DiagnoseOptions o = three_candidates();
-  o.candidates = {"jam_contraction"};
-  o.fit.least_squares.max_iterations = 1;  // the paper's start is far from this optimum
-  o.max_continuations = 0;
+  DiagnoseOptions o = cut_short();
   // The continuation alone: an optimum probe also moves a fit stopped at its
   // cap (optimum_probe.h), and here takes it to convergence by itself.
   o.fit.probe_rounds = 0;
@@ -127,10 +134,7 @@ TEST(CalibDiagnoseSynth, TheBaselineIsFittedOnUntilItConverges) {
 TEST(CalibDiagnoseSynth, AFitStoppedAtItsCapIsProbedAndRestarted) {
   testing_support::ScratchDir scratch("capped-probe");
   const Dataset d = synthetic(scratch.path, false);
-  DiagnoseOptions o = three_candidates();
-  o.candidates = {"jam_contraction"};
-  o.fit.least_squares.max_iterations = 1;  // the paper's start is far from this optimum
-  o.max_continuations = 0;
+  DiagnoseOptions o = cut_short();
   const Diagnosis probed = diagnose(d, ModelParams{}, o);
   EXPECT_TRUE(std::any_of(probed.notes.begin(), probed.notes.end(), [](const std::string& note) {
     return note.find("stopped at its iteration cap short of a better point") != std::string::npos;
