@@ -26,6 +26,14 @@ def keyed(path):
     return out
 
 
+def chosen_is_plan_so_far(note):
+    """True if the note's chosen strategy ("chose NAME; strategies: NAME r in t s ...; ...")
+    was stopped at the time budget and its plan so far kept."""
+    chosen = note.split(";")[0].removeprefix("chose ")
+    entries = [part.strip().removeprefix("strategies: ") for part in note.split(";")[1:]]
+    return any(e.startswith(chosen + " ") and "plan so far" in e for e in entries)
+
+
 def main(a2_path, pf_path):
     a2, pf = keyed(a2_path), keyed(pf_path)
     both = [k for k in pf if k in a2 and a2[k]["status"] == "ok" and pf[k]["status"] == "ok"]
@@ -55,9 +63,7 @@ def main(a2_path, pf_path):
     print("chosen:", ", ".join(f"{name} {n}" for name, n in chosen.most_common()))
     notes = [pf[k].get("note", "") for k in both]
     stopped = sum("stopped at the time budget" in n for n in notes)
-    # The chosen strategy's entry in the note says whether it is a plan so far.
-    so_far = sum(any(part.strip().removeprefix("strategies: ").startswith(n.split(";")[0].removeprefix("chose ") + " ")
-                     and "plan so far" in part for part in n.split(";")[1:]) for n in notes)
+    so_far = sum(chosen_is_plan_so_far(n) for n in notes)
     print(f"plans where the budget stopped a strategy: {stopped}; chosen plans that are a stopped strategy's plan so far: {so_far}")
     print("| size | algorithm2 mean r | portfolio mean r |")
     print("|---|---|---|")

@@ -102,8 +102,8 @@ Simulator start_simulator(const PlanRequest& request, const PlanCallbacks& callb
 
 // Applies one planned action: cancellation checked first, a cancelled
 // settle thrown as PlanCancelled carrying the plan so far (result with the
-// simulator's state, which a cancelled settle leaves as it was), the action recorded in result.steps and
-// the state sent to callbacks.snapshot.
+// simulator's state, which a cancelled settle leaves as it was), the action
+// recorded in result.steps and the state sent to callbacks.snapshot.
 void apply_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks);
 
 // As apply_planned, but a settle with no (unfolded) equilibrium is a dead

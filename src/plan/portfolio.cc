@@ -119,7 +119,6 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
     const double started_s = budget.elapsed_s();
     try {
       out.result = list[k].second->plan(request, own);
-      out.score = plan_score(request, mesh, out.result->final_state);
     } catch (const PlanCancelled& stopped) {
       if (user_cancelled()) {
         const std::lock_guard<std::mutex> lock(mutex);
@@ -128,13 +127,13 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
         // Stopped at the budget: its plan so far is a plan too, and may
         // already beat Algorithm 2's (an anytime strategy).
         out.result = *stopped.partial();
-        out.score = plan_score(request, mesh, out.result->final_state);
         out.stopped_at_budget = true;
       }
       out.error = budget.describe();
     } catch (const std::exception& e) {
       out.error = e.what();
     }
+    if (out.result) out.score = plan_score(request, mesh, out.result->final_state);
     out.seconds = budget.elapsed_s() - started_s;
     if (k == 0 && out.result) budget.algorithm2_took(out.seconds);
     const std::lock_guard<std::mutex> lock(mutex);
