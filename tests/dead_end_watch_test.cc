@@ -1,8 +1,8 @@
 // The planner's dead-end watch (sim/dead_end_watch.h): a fold past the
-// refusal angle ends a flow at once; a folded mesh that has stopped moving
-// and whose residual has stopped falling ends it after the stall limit, as
-// does a flow that comes back to a state it passed; an unfolded mesh, a
-// moving one, or a residual that keeps falling, never does.
+// refusal angle ends a flow at once; a folded mesh that has stopped moving,
+// or crawls, and whose residual has stopped falling ends it after the stall
+// limit, as does a flow that comes back to a state it passed; an unfolded
+// mesh, a moving one, or a residual that keeps falling, never does.
 #include "sim/dead_end_watch.h"
 
 #include <gtest/gtest.h>
@@ -69,6 +69,35 @@ TEST(DeadEndWatch, AFoldedMeshThatKeepsMovingIsNoDeadEndHoweverTheResidualStalls
   for (int step = 0; step < 200; ++step) {
     const Eigen::Matrix3Xd moved = x.colwise() + Eigen::Vector3d(0.0, 0.0, 0.05 * step * mesh.spacing());
     EXPECT_FALSE(watch.dead_end(moved, 1.0)) << step;
+  }
+}
+
+// A flow that stays folded and crawls, 0.02 h a step (0.4 h in 20), its
+// residual not falling, goes nowhere either (the bunny and Luxembourg 9 x 12
+// sags crawl 0.6-0.7 h in 20 steps before they stand still or come back).
+TEST(DeadEndWatch, AFoldedMeshThatCrawlsIsADeadEndAfterTheStallLimit) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  const Eigen::Matrix3Xd x = folded_between_the_limits(mesh);
+  DeadEndWatch watch(mesh, kOptions);
+  int step = 0;
+  while (!watch.dead_end(x.colwise() + Eigen::Vector3d(0.0, 0.0, 0.02 * step * mesh.spacing()), 1.0)) {
+    ++step;
+    ASSERT_LE(step, kOptions.stall_steps) << "not a dead end after " << step << " crawling steps";
+  }
+  EXPECT_EQ(step, kOptions.stall_steps);
+  EXPECT_EQ(std::string(watch.reason()), "stalled on a folded mesh");
+}
+
+// A crawl that unfolds once in the window may be on its way out of the fold.
+TEST(DeadEndWatch, ACrawlThatUnfoldedWithinTheStallLimitIsNoDeadEnd) {
+  const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
+  const Eigen::Matrix3Xd folded = folded_between_the_limits(mesh);
+  DeadEndWatch watch(mesh, kOptions);
+  for (int step = 0; step < 200; ++step) {
+    // Unfolded every 15th step, each time somewhere new.
+    const Eigen::Matrix3Xd base = step % 15 == 14 ? Eigen::Matrix3Xd(mesh.rest_positions()) : folded;
+    const Eigen::Matrix3Xd crawled = base.colwise() + Eigen::Vector3d(0.0, 0.0, 0.02 * step * mesh.spacing());
+    EXPECT_FALSE(watch.dead_end(crawled, 1.0)) << step;
   }
 }
 

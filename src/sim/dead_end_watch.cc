@@ -14,8 +14,9 @@ bool DeadEndWatch::dead_end(const Eigen::Matrix3Xd& x, double residual_n) {
     reason_ = "folded past the refusal angle";
     return true;
   }
-  const bool stalled = options_.stall_steps > 0 && sharpest > options_.stall_fold_deg && returned(x, residual_n);
-  history_.push_back({x, residual_n});
+  const bool stalled = options_.stall_steps > 0 && sharpest > options_.stall_fold_deg &&
+                       (returned(x, residual_n) || crawled(x, residual_n));
+  history_.push_back({x, residual_n, sharpest});
   if (history_.size() > kMaxHistory) history_.pop_front();
   if (!stalled) return false;
   reason_ = "stalled on a folded mesh";
@@ -30,6 +31,16 @@ bool DeadEndWatch::returned(const Eigen::Matrix3Xd& x, double residual_n) const 
     if (residual_n >= 0.5 * passed.residual_n && (x - passed.x).colwise().norm().maxCoeff() < near) return true;
   }
   return false;
+}
+
+bool DeadEndWatch::crawled(const Eigen::Matrix3Xd& x, double residual_n) const {
+  const int first = static_cast<int>(history_.size()) - options_.stall_steps;
+  if (first < 0) return false;
+  for (int i = first; i < static_cast<int>(history_.size()); ++i)
+    if (history_[i].sharpest_deg <= options_.stall_fold_deg) return false;
+  const Passed& then = history_[first];
+  const double near = options_.crawl_move_fraction * mesh_->spacing();
+  return residual_n >= 0.5 * then.residual_n && (x - then.x).colwise().norm().maxCoeff() < near;
 }
 
 }  // namespace hj

@@ -12,7 +12,10 @@
 // a period of about 40 steps, folds coming and going around 120 degrees, and
 // comes back within 0.4 mm of where it stood a period before. Both are a
 // return: the flow stands, folded, near a state it passed at least
-// stall_steps before, and its residual has not halved since.
+// stall_steps before, and its residual has not halved since. Before either
+// returns it crawls: folded all the while, its points move at most 0.6-0.7
+// of a mesh spacing in 20 steps (Luxembourg, the bunny) where the 5 x 7
+// snap-through moves 2.1-3.4; that crawl, too, is a stall.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,6 +35,11 @@ struct DeadEndWatchOptions {
   double stall_fold_deg = 120.0;
   int stall_steps = 20;
   double stall_move_fraction = 0.25;
+  // Folded past stall_fold_deg at every one of the last stall_steps accepted
+  // steps, with every point within crawl_move_fraction of the spacing of
+  // where it stood stall_steps before, and the residual above half of that
+  // state's, the flow is crawling: stalled too.
+  double crawl_move_fraction = 0.75;
 };
 
 class DeadEndWatch {
@@ -46,12 +54,15 @@ class DeadEndWatch {
  private:
   // True if the flow is back near a state of history_ at least stall_steps old.
   bool returned(const Eigen::Matrix3Xd& x, double residual_n) const;
+  // True if the flow has stayed folded and crawled for the last stall_steps.
+  bool crawled(const Eigen::Matrix3Xd& x, double residual_n) const;
 
   const Mesh* mesh_;
   DeadEndWatchOptions options_;
   struct Passed {
     Eigen::Matrix3Xd x;
     double residual_n;
+    double sharpest_deg;
   };
   // Every accepted step's positions and residual, oldest first (at most
   // kMaxHistory: a planner's settle budget is smaller).
