@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "sim/mesh_folds.h"
 #include "sim/simulator.h"
@@ -26,6 +27,21 @@ Eigen::Matrix3Xd folded_between_the_limits(const Mesh& mesh) {
 }
 
 constexpr DeadEndWatchOptions kOptions{150.0, 120.0, 20};
+
+// Feeds the watch flow(step) = (positions, residual) step by step and
+// expects "stalled on a folded mesh" at exactly the stall limit.
+template <typename Flow>
+void expect_stalled_after_the_limit(const Mesh& mesh, Flow flow) {
+  DeadEndWatch watch(mesh, kOptions);
+  int step = 0;
+  for (;; ++step) {
+    const auto [x, residual_n] = flow(step);
+    if (watch.dead_end(x, residual_n)) break;
+    ASSERT_LT(step, kOptions.stall_steps) << "not a dead end after " << step + 1 << " steps";
+  }
+  EXPECT_EQ(step, kOptions.stall_steps);
+  EXPECT_EQ(std::string(watch.reason()), "stalled on a folded mesh");
+}
 
 TEST(DeadEndWatch, AnUnfoldedMeshIsNeverADeadEndHoweverTheResidualStalls) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
@@ -48,16 +64,9 @@ TEST(DeadEndWatch, AFoldedMeshThatStandsStillAndStopsFallingIsADeadEndAfterTheSt
   const double sharpest = find_mesh_folds(mesh, x).sharpest_deg;
   ASSERT_GT(sharpest, kOptions.stall_fold_deg);
   ASSERT_LT(sharpest, kOptions.refuse_fold_deg);
-  DeadEndWatch watch(mesh, kOptions);
   // The mesh stands still; the residual wanders (0.6 to 1.4 x its first
   // value) but never halves.
-  int step = 0;
-  while (!watch.dead_end(x, 1.0 + 0.4 * std::sin(step))) {
-    ++step;
-    ASSERT_LE(step, kOptions.stall_steps) << "not a dead end after " << step << " stalled steps";
-  }
-  EXPECT_EQ(step, kOptions.stall_steps);
-  EXPECT_EQ(std::string(watch.reason()), "stalled on a folded mesh");
+  expect_stalled_after_the_limit(mesh, [&](int step) { return std::make_pair(x, 1.0 + 0.4 * std::sin(step)); });
 }
 
 // A snap-through passes folded states with a residual that does not fall,
@@ -78,14 +87,9 @@ TEST(DeadEndWatch, AFoldedMeshThatKeepsMovingIsNoDeadEndHoweverTheResidualStalls
 TEST(DeadEndWatch, AFoldedMeshThatCrawlsIsADeadEndAfterTheStallLimit) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
   const Eigen::Matrix3Xd x = folded_between_the_limits(mesh);
-  DeadEndWatch watch(mesh, kOptions);
-  int step = 0;
-  while (!watch.dead_end(x.colwise() + Eigen::Vector3d(0.0, 0.0, 0.02 * step * mesh.spacing()), 1.0)) {
-    ++step;
-    ASSERT_LE(step, kOptions.stall_steps) << "not a dead end after " << step << " crawling steps";
-  }
-  EXPECT_EQ(step, kOptions.stall_steps);
-  EXPECT_EQ(std::string(watch.reason()), "stalled on a folded mesh");
+  expect_stalled_after_the_limit(mesh, [&](int step) {
+    return std::make_pair(Eigen::Matrix3Xd(x.colwise() + Eigen::Vector3d(0.0, 0.0, 0.02 * step * mesh.spacing())), 1.0);
+  });
 }
 
 // A crawl that unfolds once in the window may be on its way out of the fold.
