@@ -8,7 +8,7 @@ both "luxembourg_elev"). Prints the mean correlation of each and the mean,
 smallest and largest gain, the plans where the portfolio is more than 0.01
 below, the portfolio's time over its own Algorithm 2 run's (from its note),
 the same against the Algorithm 2 sweep's own rows (both include goal
-resampling and scoring), the strategies it chose, and the mean per size.
+resampling and scoring) and in total, the strategies it chose, and the mean per size.
 """
 import collections
 import csv
@@ -57,6 +57,8 @@ def main(a2_path, pf_path):
     print(f"portfolio more than 0.01 below algorithm2: {len(below)} {below}")
     if ratios:
         print(f"portfolio time / its algorithm2's: median {statistics.median(ratios):.2f}, largest {max(ratios):.2f}")
+    pf_total, a2_total = (sum(float(rows[k]["seconds"]) for k in both) for rows in (pf, a2))
+    print(f"total time: portfolio {pf_total:.0f} s, algorithm2 sweep {a2_total:.0f} s: {pf_total / a2_total:.2f} x")
     worst = max(zip(row_ratios, both))
     print(f"portfolio row time / algorithm2 sweep row time: median {statistics.median(row_ratios):.2f}, "
           f"largest {worst[0]:.2f} ({worst[1][0]} {worst[1][1]}x{worst[1][2]})")
