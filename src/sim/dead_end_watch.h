@@ -15,7 +15,8 @@
 // stall_steps before, and its residual has not halved since. Before either
 // returns it crawls: folded all the while, its points move at most 0.6-0.7
 // of a mesh spacing in 20 steps (Luxembourg, the bunny) where the 5 x 7
-// snap-through moves 2.1-3.4; that crawl, too, is a stall.
+// snap-through moves 2.1-3.4; that crawl, too, is a stall. (One folded crawl
+// seen went on to settle, random goal 91 of docs/random-goals.md: refused.)
 #pragma once
 
 #include <Eigen/Core>
