@@ -43,6 +43,19 @@ void expect_stalled_after_the_limit(const Mesh& mesh, Flow flow) {
   EXPECT_EQ(std::string(watch.reason()), "stalled on a folded mesh");
 }
 
+// `base` lifted by `per_step` mesh spacings a step: a surface on its way.
+Eigen::Matrix3Xd lifted(const Mesh& mesh, const Eigen::Matrix3Xd& base, int step, double per_step) {
+  return base.colwise() + Eigen::Vector3d(0.0, 0.0, per_step * step * mesh.spacing());
+}
+
+// Feeds the watch positions(step) for 200 steps, the residual never
+// falling, and expects no dead end.
+template <typename Positions>
+void expect_never_a_dead_end(const Mesh& mesh, Positions positions) {
+  DeadEndWatch watch(mesh, kOptions);
+  for (int step = 0; step < 200; ++step) EXPECT_FALSE(watch.dead_end(positions(step), 1.0)) << step;
+}
+
 TEST(DeadEndWatch, AnUnfoldedMeshIsNeverADeadEndHoweverTheResidualStalls) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
   DeadEndWatch watch(mesh, kOptions);
@@ -74,11 +87,7 @@ TEST(DeadEndWatch, AFoldedMeshThatStandsStillAndStopsFallingIsADeadEndAfterTheSt
 TEST(DeadEndWatch, AFoldedMeshThatKeepsMovingIsNoDeadEndHoweverTheResidualStalls) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
   const Eigen::Matrix3Xd x = folded_between_the_limits(mesh);
-  DeadEndWatch watch(mesh, kOptions);
-  for (int step = 0; step < 200; ++step) {
-    const Eigen::Matrix3Xd moved = x.colwise() + Eigen::Vector3d(0.0, 0.0, 0.05 * step * mesh.spacing());
-    EXPECT_FALSE(watch.dead_end(moved, 1.0)) << step;
-  }
+  expect_never_a_dead_end(mesh, [&](int step) { return lifted(mesh, x, step, 0.05); });
 }
 
 // A flow that stays folded and crawls, 0.02 h a step (0.4 h in 20), its
@@ -87,22 +96,17 @@ TEST(DeadEndWatch, AFoldedMeshThatKeepsMovingIsNoDeadEndHoweverTheResidualStalls
 TEST(DeadEndWatch, AFoldedMeshThatCrawlsIsADeadEndAfterTheStallLimit) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
   const Eigen::Matrix3Xd x = folded_between_the_limits(mesh);
-  expect_stalled_after_the_limit(mesh, [&](int step) {
-    return std::make_pair(Eigen::Matrix3Xd(x.colwise() + Eigen::Vector3d(0.0, 0.0, 0.02 * step * mesh.spacing())), 1.0);
-  });
+  expect_stalled_after_the_limit(mesh, [&](int step) { return std::make_pair(lifted(mesh, x, step, 0.02), 1.0); });
 }
 
 // A crawl that unfolds once in the window may be on its way out of the fold.
 TEST(DeadEndWatch, ACrawlThatUnfoldedWithinTheStallLimitIsNoDeadEnd) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
   const Eigen::Matrix3Xd folded = folded_between_the_limits(mesh);
-  DeadEndWatch watch(mesh, kOptions);
-  for (int step = 0; step < 200; ++step) {
-    // Unfolded every 15th step, each time somewhere new.
-    const Eigen::Matrix3Xd base = step % 15 == 14 ? Eigen::Matrix3Xd(mesh.rest_positions()) : folded;
-    const Eigen::Matrix3Xd crawled = base.colwise() + Eigen::Vector3d(0.0, 0.0, 0.02 * step * mesh.spacing());
-    EXPECT_FALSE(watch.dead_end(crawled, 1.0)) << step;
-  }
+  // Unfolded every 15th step, each time somewhere new.
+  expect_never_a_dead_end(mesh, [&](int step) {
+    return lifted(mesh, step % 15 == 14 ? Eigen::Matrix3Xd(mesh.rest_positions()) : folded, step, 0.02);
+  });
 }
 
 TEST(DeadEndWatch, AFoldedMeshWhoseResidualKeepsFallingIsNoDeadEnd) {
@@ -135,12 +139,9 @@ TEST(DeadEndWatch, AFlowThatComesBackToAFoldedStateItPassedIsADeadEndThoughItUnf
 TEST(DeadEndWatch, AFlowThatFoldsUnfoldsAndMovesOnIsNoDeadEnd) {
   const Mesh mesh(ArrayGeometry{2, 2, 0.038, 4});
   const Eigen::Matrix3Xd folded = folded_between_the_limits(mesh);
-  DeadEndWatch watch(mesh, kOptions);
-  for (int step = 0; step < 200; ++step) {
-    const Eigen::Matrix3Xd base = step % 7 == 6 ? Eigen::Matrix3Xd(mesh.rest_positions()) : folded;
-    const Eigen::Matrix3Xd moved = base.colwise() + Eigen::Vector3d(0.0, 0.0, 0.05 * step * mesh.spacing());
-    EXPECT_FALSE(watch.dead_end(moved, 1.0)) << step;
-  }
+  expect_never_a_dead_end(mesh, [&](int step) {
+    return lifted(mesh, step % 7 == 6 ? Eigen::Matrix3Xd(mesh.rest_positions()) : folded, step, 0.05);
+  });
 }
 
 TEST(DeadEndWatch, ZeroStallStepsTurnTheStallLimitOff) {

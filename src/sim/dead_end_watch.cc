@@ -15,7 +15,7 @@ bool DeadEndWatch::dead_end(const Eigen::Matrix3Xd& x, double residual_n) {
     return true;
   }
   const bool stalled = options_.stall_steps > 0 && sharpest > options_.stall_fold_deg &&
-                       (returned(x, residual_n) || crawled(x, residual_n));
+                       (crawled(x, residual_n) || returned(x, residual_n));
   history_.push_back({x, residual_n, sharpest});
   if (history_.size() > kMaxHistory) history_.pop_front();
   if (!stalled) return false;
@@ -26,10 +26,8 @@ bool DeadEndWatch::dead_end(const Eigen::Matrix3Xd& x, double residual_n) {
 bool DeadEndWatch::returned(const Eigen::Matrix3Xd& x, double residual_n) const {
   const double near = options_.stall_move_fraction * mesh_->spacing();
   const int old_enough = static_cast<int>(history_.size()) - options_.stall_steps + 1;
-  for (int i = 0; i < old_enough; ++i) {
-    const Passed& passed = history_[i];
-    if (residual_n >= 0.5 * passed.residual_n && (x - passed.x).colwise().norm().maxCoeff() < near) return true;
-  }
+  for (int i = 0; i < old_enough; ++i)
+    if (still_near(history_[i], x, residual_n, near)) return true;
   return false;
 }
 
@@ -38,9 +36,11 @@ bool DeadEndWatch::crawled(const Eigen::Matrix3Xd& x, double residual_n) const {
   if (first < 0) return false;
   for (int i = first; i < static_cast<int>(history_.size()); ++i)
     if (history_[i].sharpest_deg <= options_.stall_fold_deg) return false;
-  const Passed& then = history_[first];
-  const double near = options_.crawl_move_fraction * mesh_->spacing();
-  return residual_n >= 0.5 * then.residual_n && (x - then.x).colwise().norm().maxCoeff() < near;
+  return still_near(history_[first], x, residual_n, options_.crawl_move_fraction * mesh_->spacing());
+}
+
+bool DeadEndWatch::still_near(const Passed& passed, const Eigen::Matrix3Xd& x, double residual_n, double near) {
+  return residual_n >= 0.5 * passed.residual_n && (x - passed.x).colwise().norm().maxCoeff() < near;
 }
 
 }  // namespace hj

@@ -65,6 +65,9 @@ class DeadEndWatch {
     double residual_n;
     double sharpest_deg;
   };
+  // True if every point of x is within `near` of `passed` and the residual
+  // has not halved since.
+  static bool still_near(const Passed& passed, const Eigen::Matrix3Xd& x, double residual_n, double near);
   // Every accepted step's positions and residual, oldest first (at most
   // kMaxHistory: a planner's settle budget is smaller).
   std::deque<Passed> history_;
