@@ -6,6 +6,7 @@
 // fitted error a little.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "calib/diagnosis.h"
@@ -44,6 +45,15 @@ TEST(Diagnose, FindsTheBendingStiffnessInDemoBending) {
   const auto& bending = params.effect_parameters.at("bending");
   ASSERT_EQ(bending.size(), 1u);
   EXPECT_NEAR(bending.begin()->second, 0.002, 0.0002);
+  // The held-out RMSE pools the folds: one figure and one step per session.
+  const CandidateFit& chosen = result.ranking[0];
+  ASSERT_EQ(chosen.heldout_session_rmse_mm.size(), d.sessions.size());
+  ASSERT_EQ(chosen.fold_step.size(), d.sessions.size());
+  const auto [least, most] =
+      std::minmax_element(chosen.heldout_session_rmse_mm.begin(), chosen.heldout_session_rmse_mm.end());
+  EXPECT_LE(*least, chosen.heldout_rmse_mm + 1e-9);
+  EXPECT_GE(*most, chosen.heldout_rmse_mm - 1e-9);
+  for (double t : chosen.fold_step) EXPECT_TRUE(t >= 0.0 && t <= 1.0) << t;
   ASSERT_EQ(result.ladder.size(), 2u);
   EXPECT_LT(result.ladder[1].heldout_rmse_mm, result.ladder[0].heldout_rmse_mm);
   // area_pressure is not refitted: screened out, or predicted far above

@@ -18,6 +18,8 @@ nlohmann::json candidate_json(const CandidateFit& c) {
                       {"screened_out", c.screened_out},
                       {"params", model_params_json(c.fit.params)},
                       {"uncertainties", uncertainties_json(c.fit)}};
+  if (!c.heldout_session_rmse_mm.empty())
+    j["heldout_by_session"] = {{"rmse_mm", c.heldout_session_rmse_mm}, {"fold_step", c.fold_step}};
   if (c.screened_out) j["screening"] = c.screening_note;
   if (!c.scan_note.empty()) j["scan"] = c.scan_note;
   if (!c.recheck_note.empty()) j["recheck"] = c.recheck_note;

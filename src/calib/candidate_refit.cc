@@ -119,7 +119,7 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
     if (!s.options.multi_start_before_refit) refit_over_range_if_unexplained(s, parameters, fit_progress, c);
     probe_if_unexplained(s, parameters, stage, c);
     if (progress) progress("cross-validation", 0, 1, effect);
-    c.heldout_rmse_mm = cross_validate(s.dataset, parameters, c.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
+    cross_validate_candidate(s.dataset, parameters, s.options.fit.least_squares.replay, c);
     c.delta_bic = bic(c.fit) - bic(s.current);
     c.significant = is_significant(c, s.current, s.current_heldout, s.options);
   } catch (const SettleInterrupted&) {
@@ -178,7 +178,7 @@ bool refit_from_rebased_current(Selection& s, CandidateFit& c) {
                   c.fit.rmse_mm, again.rmse_mm);
     c.fit = std::move(again);
     if (s.progress) s.progress("cross-validation", 0, 1, c.added);
-    c.heldout_rmse_mm = cross_validate(s.dataset, parameters, c.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
+    cross_validate_candidate(s.dataset, parameters, s.options.fit.least_squares.replay, c);
     c.recheck_note = note;
     return true;
   } catch (const SettleInterrupted&) {

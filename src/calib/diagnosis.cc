@@ -76,6 +76,18 @@ bool converge(const Dataset& dataset, const std::vector<FitParameter>& parameter
   return moved;
 }
 
+}  // namespace
+
+void cross_validate_candidate(const Dataset& dataset, const std::vector<FitParameter>& parameters,
+                              const ReplayOptions& replay, CandidateFit& c) {
+  CrossValidation cv = cross_validate(dataset, parameters, c.fit, replay);
+  c.heldout_rmse_mm = cv.heldout_rmse_mm;
+  c.heldout_session_rmse_mm = std::move(cv.session_rmse_mm);
+  c.fold_step = std::move(cv.fold_step);
+}
+
+namespace {
+
 // Best first: the significant ones, then by held-out RMSE.
 void rank(std::vector<CandidateFit>& fits) {
   std::stable_sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
@@ -119,7 +131,8 @@ bool recheck_current(const Dataset& dataset, const DiagnoseOptions& options, int
   if (!better) return false;
   current = std::move(refit);
   if (progress) progress("cross-validation", 0, 1, label);
-  current_heldout = cross_validate(dataset, parameters, current, options.fit.least_squares.replay).heldout_rmse_mm;
+  const CrossValidation cv = cross_validate(dataset, parameters, current, options.fit.least_squares.replay);
+  current_heldout = cv.heldout_rmse_mm;
   if (progress) progress("cross-validation", 1, 1, label);
   out.ladder.back().rmse_mm = current.rmse_mm;
   out.ladder.back().heldout_rmse_mm = current_heldout;
@@ -136,6 +149,8 @@ bool recheck_current(const Dataset& dataset, const DiagnoseOptions& options, int
           chosen_fit.delta_bic += bic(current) - bic(chosen_fit.fit);
           chosen_fit.fit = current;
           chosen_fit.heldout_rmse_mm = current_heldout;
+          chosen_fit.heldout_session_rmse_mm = cv.session_rmse_mm;
+          chosen_fit.fold_step = cv.fold_step;
           chosen_fit.recheck_note = "refitted from " + c.added + "'s optimum with " + c.added + " off";
         }
   }
@@ -303,8 +318,7 @@ bool converge_choice(Selection& s, std::vector<CandidateFit>& fits) {
   for (const auto& e : best.effects) label += " + " + e;
   const auto best_parameters = fit_parameters(best.effects);
   if (converge(s.dataset, best_parameters, s.options, label, s.progress, best.fit, s.out.notes)) {
-    best.heldout_rmse_mm =
-        cross_validate(s.dataset, best_parameters, best.fit, s.options.fit.least_squares.replay).heldout_rmse_mm;
+    cross_validate_candidate(s.dataset, best_parameters, s.options.fit.least_squares.replay, best);
     best.delta_bic = bic(best.fit) - bic(s.current);
   }
   note_gain_in_one_capture(s.dataset, s.current, best, s.out.notes);

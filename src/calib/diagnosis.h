@@ -94,6 +94,9 @@ struct CandidateFit {
   std::string added;                 // the effect this candidate adds
   LeastSquaresResult fit;
   double heldout_rmse_mm = 0.0;
+  // Each session's RMSE when held out, and the share of its fold's step
+  // taken (cross_validation.h); empty where the figure is a prediction.
+  std::vector<double> heldout_session_rmse_mm, fold_step;
   double delta_bic = 0.0;            // against the model it extends
   bool significant = false;
   // Not refitted: fit.params, fit.rmse_mm, heldout_rmse_mm and delta_bic
@@ -120,6 +123,10 @@ struct CandidateFit {
   // The RMSE at the scan's best point (or the start); NaN if not scanned.
   double scan_rmse_mm = std::numeric_limits<double>::quiet_NaN();
 };
+
+// Cross-validates c's fit with `parameters`, setting its held-out figures.
+void cross_validate_candidate(const Dataset& dataset, const std::vector<FitParameter>& parameters,
+                              const ReplayOptions& replay, CandidateFit& c);
 
 struct LadderStep {
   std::string label;  // "baseline", "+ bending", ...
