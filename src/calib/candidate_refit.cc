@@ -11,12 +11,19 @@
 
 namespace hj {
 
-bool is_significant(const CandidateFit& c, const LeastSquaresResult& current, double reference_heldout_mm,
-                    const DiagnoseOptions& options) {
-  const bool fits_better = c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm ||
+double excess_share_removed(const CandidateFit& c, const Selection& s) {
+  const double floor2 = s.out.noise_floor_mm * s.out.noise_floor_mm;
+  const double excess = s.current.rmse_mm * s.current.rmse_mm - floor2;
+  if (!(excess > 0.0)) return 1.0;
+  return (s.current.rmse_mm * s.current.rmse_mm - c.fit.rmse_mm * c.fit.rmse_mm) / excess;
+}
+
+bool is_significant(const CandidateFit& c, const Selection& s) {
+  const DiagnoseOptions& options = s.options;
+  const bool fits_better = c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * s.current.rmse_mm ||
                            c.delta_bic < options.strong_delta_bic;
-  return c.heldout_rmse_mm <= (1.0 - options.min_heldout_gain) * reference_heldout_mm &&
-         c.delta_bic < options.max_delta_bic && fits_better;
+  return c.heldout_rmse_mm <= (1.0 - options.min_heldout_gain) * s.current_heldout &&
+         c.delta_bic < options.max_delta_bic && fits_better && excess_share_removed(c, s) >= options.min_excess_share;
 }
 
 namespace {
@@ -102,6 +109,22 @@ void probe_if_unexplained(const Selection& s, const std::vector<FitParameter>& p
   for (const std::string& note : notes) c.probe_note += (c.probe_note.empty() ? "" : "; ") + note;
 }
 
+// Says so in notes where a candidate passes every test except the share of
+// the misfit above the floor it removes: the user sees it was weighed.
+void note_if_immaterial(Selection& s, const CandidateFit& c) {
+  const double share = excess_share_removed(c, s);
+  if (c.significant || share >= s.options.min_excess_share) return;
+  CandidateFit material = c;
+  material.fit.rmse_mm = 0.0;  // as if it removed the whole misfit
+  if (!is_significant(material, s)) return;
+  char note[300];
+  std::snprintf(note, sizeof note,
+                "%s lowers the error (RMSE %.4f -> %.4f mm) but removes only %.0f %% of the misfit above the noise "
+                "floor (needs %.0f %%): not chosen, the effect in the data is another",
+                c.added.c_str(), s.current.rmse_mm, c.fit.rmse_mm, 100.0 * share, 100.0 * s.options.min_excess_share);
+  s.out.notes.push_back(note);
+}
+
 // Refits one candidate from the current optimum, cross-validates it and
 // judges it; false (and said so in out.skipped) if the model cannot replay it.
 bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
@@ -121,7 +144,8 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
     if (progress) progress("cross-validation", 0, 1, effect);
     cross_validate_candidate(s.dataset, parameters, s.options.fit.least_squares.replay, c);
     c.delta_bic = bic(c.fit) - bic(s.current);
-    c.significant = is_significant(c, s.current, s.current_heldout, s.options);
+    c.significant = is_significant(c, s);
+    note_if_immaterial(s, c);
   } catch (const SettleInterrupted&) {
     throw;  // the caller stopped the work: not a failed replay
   } catch (const std::exception& e) {

@@ -301,7 +301,7 @@ void recheck_like_with_like(Selection& s, int round, std::vector<CandidateFit>& 
       const bool refitted = c.fit.sum_sq_mm2 > s.current.sum_sq_mm2 && refit_from_rebased_current(s, c);
       c.delta_bic = bic(c.fit) - bic(s.current);
       if (!refitted && !c.significant) continue;
-      c.significant = is_significant(c, s.current, s.current_heldout, s.options);
+      c.significant = is_significant(c, s);
       if (!refitted && !c.significant) c.recheck_note = why;
     }
     rank(fits);

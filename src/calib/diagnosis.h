@@ -40,6 +40,12 @@ struct DiagnoseOptions {
   // 1.509 -> 1.041, delta BIC -487). An effect that does not move the frames
   // cannot lower the BIC by that much.
   double strong_delta_bic = -100.0;
+  // ... and it must remove at least this share of the current model's
+  // misfit above the noise floor (RMSE^2 - floor^2): an effect that lowers
+  // the error significantly but leaves nearly all the misfit is not the
+  // one the data miss (an unregistered 5 mm camera bump: area_pressure
+  // removed 4 % of it and was chosen).
+  double min_excess_share = 0.1;
   // Screening (screening.h): a candidate is refitted and cross-validated
   // only if its predicted held-out gain is at least screen_margin *
   // min_heldout_gain and its predicted delta BIC below screen_margin *

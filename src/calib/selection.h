@@ -34,7 +34,13 @@ struct Selection {
 // is about six standard errors of an RMSE estimated from 1.7e5 samples
 // (relative s.e. 1 / sqrt(2 n)), and far less than any effect worth
 // modelling changes.
-bool is_significant(const CandidateFit& c, const LeastSquaresResult& current, double reference_heldout_mm,
-                    const DiagnoseOptions& options);
+// It must also remove a material share of what the current model leaves
+// above the noise floor (DiagnoseOptions::min_excess_share).
+bool is_significant(const CandidateFit& c, const Selection& s);
+
+// The share of the current model's misfit above the noise floor (RMSE^2 -
+// floor^2) that c's fit removes; 1 where the current model is at or below
+// the floor (then there is no misfit to share out).
+double excess_share_removed(const CandidateFit& c, const Selection& s);
 
 }  // namespace hj
