@@ -9,6 +9,7 @@
 
 #include "calib/cross_validation.h"
 #include "calib/fit_model.h"
+#include "calib/fold_refit.h"
 
 namespace hj {
 namespace {
@@ -70,6 +71,33 @@ TEST(CrossValidation, AFoldThatLeapsIsCutBackToWhereItFitsItsTrainingSessions) {
               cost_without(d, s, fit.params, options.replay) * (1.0 + 1e-12))
         << "fold " << s << " raised its training cost (step " << t << ")";
   }
+}
+
+// A fold refitted for real (calib/fold_refit.h) is the fit without the
+// held-out session, and where the model is close to linear its held-out
+// error is what the one-step fold predicts.
+TEST(CrossValidation, AFoldRefitIsTheFitWithoutItsSession) {
+  const Dataset d = select_sessions(read_dataset(kBaseline), {"unjammed-sweep", "mixed-1"}, true);
+  ModelParams start;
+  start.surface.mass_kg = 0.52;
+  start.surface.spring_k = 58.0;
+  start.surface.kappa_jam = 4.2;
+  LeastSquaresOptions options;
+  options.max_iterations = 8;
+  const auto parameters = fit_parameters({});
+  const LeastSquaresResult fit = fit_least_squares(d, start, parameters, options);
+  const CrossValidation one_step = cross_validate(d, parameters, fit, options.replay);
+  for (int s = 0; s < static_cast<int>(d.sessions.size()); ++s) {
+    const FoldRefit fold = refit_fold(d, parameters, fit, s, options);
+    const Dataset training = select_sessions(d, {d.sessions[s].session.name}, false);
+    const LeastSquaresResult direct = fit_least_squares(training, fit.params, parameters, options);
+    EXPECT_NEAR(fold.params.surface.mass_kg, direct.params.surface.mass_kg, 1e-9);
+    EXPECT_NEAR(fold.params.surface.spring_k, direct.params.surface.spring_k, 1e-6);
+    EXPECT_GT(fold.heldout_count, 0);
+    EXPECT_NEAR(fold.heldout_rmse_mm, one_step.session_rmse_mm[s], 0.05) << d.sessions[s].session.name;
+  }
+  // Pooled over the sessions' samples: 100 at 1 mm and 300 at 2 mm.
+  EXPECT_NEAR(pooled_heldout_rmse({1.0, 2.0}, {0, 100, 400}), std::sqrt((100.0 + 1200.0) / 400.0), 1e-12);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "calib/candidate_screening.h"
+#include "calib/fold_refit.h"
 #include "calib/goodness_of_fit.h"
 #include "calib/range_start.h"
 
@@ -18,12 +19,33 @@ double excess_share_removed(const CandidateFit& c, const Selection& s) {
   return (s.current.rmse_mm * s.current.rmse_mm - c.fit.rmse_mm * c.fit.rmse_mm) / excess;
 }
 
-bool is_significant(const CandidateFit& c, const Selection& s) {
+SignificanceTests significance_tests(const CandidateFit& c, const Selection& s) {
   const DiagnoseOptions& options = s.options;
-  const bool fits_better = c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * s.current.rmse_mm ||
-                           c.delta_bic < options.strong_delta_bic;
-  return c.heldout_rmse_mm <= (1.0 - options.min_heldout_gain) * s.current_heldout &&
-         c.delta_bic < options.max_delta_bic && fits_better && excess_share_removed(c, s) >= options.min_excess_share;
+  SignificanceTests t;
+  t.heldout = c.heldout_rmse_mm <= (1.0 - options.min_heldout_gain) * s.current_heldout;
+  t.bic = c.delta_bic < options.max_delta_bic;
+  t.fit = c.fit.rmse_mm <= (1.0 - options.min_fit_gain) * s.current.rmse_mm || c.delta_bic < options.strong_delta_bic;
+  t.material = excess_share_removed(c, s) >= options.min_excess_share;
+  return t;
+}
+
+bool is_significant(const CandidateFit& c, const Selection& s) {
+  const SignificanceTests t = significance_tests(c, s);
+  return t.heldout && t.bic && t.fit && t.material;
+}
+
+void refit_fold_of(Selection& s, const std::vector<FitParameter>& parameters, int k, CandidateFit& c) {
+  const std::string& name = s.dataset.sessions[k].session.name;
+  if (s.progress) s.progress("fold refit " + c.added, 0, 1, name);
+  const FoldRefit fold = refit_fold(s.dataset, parameters, c.fit, k, s.options.fit.least_squares);
+  if (s.progress) s.progress("fold refit " + c.added, 1, 1, name);
+  char note[300];
+  std::snprintf(note, sizeof note, "%s: session %s held out is %.3f mm after its fold's one step, %.3f mm refitted without it",
+                c.added.c_str(), name.c_str(), c.heldout_session_rmse_mm[k], fold.heldout_rmse_mm);
+  s.out.notes.push_back(note);
+  c.heldout_session_rmse_mm[k] = fold.heldout_rmse_mm;
+  c.fold_step[k] = -1.0;  // refitted, not stepped
+  c.heldout_rmse_mm = pooled_heldout_rmse(c.heldout_session_rmse_mm, c.fit.session_rows);
 }
 
 namespace {
@@ -112,17 +134,41 @@ void probe_if_unexplained(const Selection& s, const std::vector<FitParameter>& p
 // Says so in notes where a candidate passes every test except the share of
 // the misfit above the floor it removes: the user sees it was weighed.
 void note_if_immaterial(Selection& s, const CandidateFit& c) {
-  const double share = excess_share_removed(c, s);
-  if (c.significant || share >= s.options.min_excess_share) return;
-  CandidateFit material = c;
-  material.fit.rmse_mm = 0.0;  // as if it removed the whole misfit
-  if (!is_significant(material, s)) return;
+  const SignificanceTests t = significance_tests(c, s);
+  if (!t.heldout || !t.bic || !t.fit || t.material) return;
   char note[300];
   std::snprintf(note, sizeof note,
                 "%s lowers the error (RMSE %.4f -> %.4f mm) but removes only %.0f %% of the misfit above the noise "
                 "floor (needs %.0f %%): not chosen, the effect in the data is another",
-                c.added.c_str(), s.current.rmse_mm, c.fit.rmse_mm, 100.0 * share, 100.0 * s.options.min_excess_share);
+                c.added.c_str(), s.current.rmse_mm, c.fit.rmse_mm, 100.0 * excess_share_removed(c, s),
+                100.0 * s.options.min_excess_share);
   s.out.notes.push_back(note);
+}
+
+// A candidate refused only by its held-out error: the folds whose held-out
+// session ends clearly above the candidate's in-sample error there are
+// refitted for real (fold_refit.h), the worst first, until it passes, at
+// most max_fold_refits of them. Says so in notes.
+void refit_deciding_folds(Selection& s, const std::vector<FitParameter>& parameters, CandidateFit& c) {
+  const SignificanceTests t = significance_tests(c, s);
+  if (t.heldout || !t.bic || !t.fit || !t.material) return;
+  const std::vector<int>& rows = c.fit.session_rows;
+  const int sessions = static_cast<int>(c.heldout_session_rmse_mm.size());
+  if (static_cast<int>(rows.size()) != sessions + 1 || c.fit.residuals.size() != rows.back()) return;
+  std::vector<std::pair<double, int>> worst;  // held-out over in-sample RMSE, session
+  for (int k = 0; k < sessions; ++k) {
+    const int n = rows[k + 1] - rows[k];
+    if (n == 0) continue;
+    const double in_sample = std::sqrt(c.fit.residuals.segment(rows[k], n).squaredNorm() / n);
+    const double ratio = c.heldout_session_rmse_mm[k] / std::max(in_sample, 1e-9);
+    if (ratio > s.options.fold_refit_ratio) worst.emplace_back(ratio, k);
+  }
+  std::sort(worst.rbegin(), worst.rend());
+  if (static_cast<int>(worst.size()) > s.options.max_fold_refits) worst.resize(s.options.max_fold_refits);
+  for (const auto& [ratio, k] : worst) {
+    refit_fold_of(s, parameters, k, c);
+    if (significance_tests(c, s).heldout) break;
+  }
 }
 
 // Refits one candidate from the current optimum, cross-validates it and
@@ -144,6 +190,7 @@ bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
     if (progress) progress("cross-validation", 0, 1, effect);
     cross_validate_candidate(s.dataset, parameters, s.options.fit.least_squares.replay, c);
     c.delta_bic = bic(c.fit) - bic(s.current);
+    refit_deciding_folds(s, parameters, c);
     c.significant = is_significant(c, s);
     note_if_immaterial(s, c);
   } catch (const SettleInterrupted&) {

@@ -318,7 +318,11 @@ bool converge_choice(Selection& s, std::vector<CandidateFit>& fits) {
   for (const auto& e : best.effects) label += " + " + e;
   const auto best_parameters = fit_parameters(best.effects);
   if (converge(s.dataset, best_parameters, s.options, label, s.progress, best.fit, s.out.notes)) {
+    const std::vector<double> steps_before = best.fold_step;
     cross_validate_candidate(s.dataset, best_parameters, s.options.fit.least_squares.replay, best);
+    // A fold its judgement refitted for real is refitted again from the new optimum.
+    for (size_t k = 0; k < steps_before.size() && k < best.fold_step.size(); ++k)
+      if (steps_before[k] < 0.0) refit_fold_of(s, best_parameters, static_cast<int>(k), best);
     best.delta_bic = bic(best.fit) - bic(s.current);
   }
   note_gain_in_one_capture(s.dataset, s.current, best, s.out.notes);

@@ -46,6 +46,12 @@ struct DiagnoseOptions {
   // one the data miss (an unregistered 5 mm camera bump: area_pressure
   // removed 4 % of it and was chosen).
   double min_excess_share = 0.1;
+  // A refitted candidate that passes every test but the held-out one has
+  // the folds whose held-out session ends above fold_refit_ratio times its
+  // in-sample RMSE there refitted for real (fold_refit.h), the worst first,
+  // at most max_fold_refits of them; 0: none.
+  double fold_refit_ratio = 1.25;
+  int max_fold_refits = 2;
   // Screening (screening.h): a candidate is refitted and cross-validated
   // only if its predicted held-out gain is at least screen_margin *
   // min_heldout_gain and its predicted delta BIC below screen_margin *
@@ -101,7 +107,8 @@ struct CandidateFit {
   LeastSquaresResult fit;
   double heldout_rmse_mm = 0.0;
   // Each session's RMSE when held out, and the share of its fold's step
-  // taken (cross_validation.h); empty where the figure is a prediction.
+  // taken (cross_validation.h), -1 for a fold refitted for real
+  // (fold_refit.h); empty where the figure is a prediction.
   std::vector<double> heldout_session_rmse_mm, fold_step;
   double delta_bic = 0.0;            // against the model it extends
   bool significant = false;

@@ -36,7 +36,18 @@ struct Selection {
 // modelling changes.
 // It must also remove a material share of what the current model leaves
 // above the noise floor (DiagnoseOptions::min_excess_share).
+struct SignificanceTests {
+  bool heldout = false;   // the held-out RMSE falls by min_heldout_gain
+  bool bic = false;       // delta BIC below max_delta_bic
+  bool fit = false;       // the in-sample RMSE falls by min_fit_gain, or delta BIC below strong_delta_bic
+  bool material = false;  // min_excess_share of the misfit above the floor removed
+};
+SignificanceTests significance_tests(const CandidateFit& c, const Selection& s);
 bool is_significant(const CandidateFit& c, const Selection& s);
+
+// Refits c's fold that holds out session k for real (fold_refit.h) and sets
+// its held-out figures from it (fold_step[k] = -1); says so in notes.
+void refit_fold_of(Selection& s, const std::vector<FitParameter>& parameters, int k, CandidateFit& c);
 
 // The share of the current model's misfit above the noise floor (RMSE^2 -
 // floor^2) that c's fit removes; 1 where the current model is at or below
