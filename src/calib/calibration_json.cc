@@ -27,7 +27,7 @@ nlohmann::json candidate_json(const CandidateFit& c) {
   if (!c.starts_tried.empty()) {
     nlohmann::json starts = nlohmann::json::array();
     for (const auto& t : c.starts_tried)
-      starts.push_back({{"start", t.value}, {"fitted", t.fitted}, {"rmse_mm", t.rmse_mm}});
+      starts.push_back({{"parameter", t.parameter}, {"start", t.value}, {"fitted", t.fitted}, {"rmse_mm", t.rmse_mm}});
     j["starts"] = {{"parameter", c.multi_start_parameter}, {"tried", starts}};
   }
   if (c.screened)

@@ -26,41 +26,40 @@ std::vector<double> range_starts(const ParameterSpec& spec, int starts) {
 bool wants_multi_start(const std::string& effect) {
   const EffectInfo& info = EffectRegistry::instance().get(effect);
   if (info.measurement_only) return false;
-  int fitted = 0;
-  for (const auto& spec : info.parameters) fitted += is_fitted(spec);
-  return fitted == 1;
+  for (const auto& spec : info.parameters)
+    if (is_fitted(spec)) return true;
+  return false;
 }
 
 MultiStart multi_start(const Dataset& dataset, const ModelParams& start, const std::vector<FitParameter>& parameters,
                        const std::string& effect, const LeastSquaresOptions& fit, const MultiStartOptions& options) {
   MultiStart out;
-  const FitParameter* parameter = nullptr;
-  for (const auto& p : parameters)
-    if (!p.surface && p.effect == effect) parameter = &p;
-  if (!parameter) return out;
-  out.parameter = parameter->qualified_name();
   LeastSquaresOptions short_fit = fit;
   short_fit.max_iterations = options.iterations;
   out.best_sum_sq_mm2 = std::numeric_limits<double>::infinity();
-  for (double value : range_starts(parameter->spec, options.starts)) {
-    ModelParams from = start;
-    set_parameter_value(from, *parameter, value);
-    StartTried tried{value, std::numeric_limits<double>::quiet_NaN(), value};
-    try {
-      const LeastSquaresResult r = fit_least_squares(dataset, from, parameters, short_fit);
-      tried.rmse_mm = r.rmse_mm;
-      tried.fitted = parameter_value(r.params, *parameter);
-      if (r.sum_sq_mm2 < out.best_sum_sq_mm2) {
-        out.best_sum_sq_mm2 = r.sum_sq_mm2;
-        out.best = r.params;
-        out.found = true;
+  for (const auto& parameter : parameters) {
+    if (parameter.surface || parameter.effect != effect) continue;
+    out.parameter += (out.parameter.empty() ? "" : ",") + parameter.qualified_name();
+    for (double value : range_starts(parameter.spec, options.starts)) {
+      ModelParams from = start;
+      set_parameter_value(from, parameter, value);
+      StartTried tried{parameter.qualified_name(), value, std::numeric_limits<double>::quiet_NaN(), value};
+      try {
+        const LeastSquaresResult r = fit_least_squares(dataset, from, parameters, short_fit);
+        tried.rmse_mm = r.rmse_mm;
+        tried.fitted = parameter_value(r.params, parameter);
+        if (r.sum_sq_mm2 < out.best_sum_sq_mm2) {
+          out.best_sum_sq_mm2 = r.sum_sq_mm2;
+          out.best = r.params;
+          out.found = true;
+        }
+      } catch (const SettleInterrupted&) {
+        throw;  // the caller stopped the work: not a failed replay
+      } catch (const std::exception&) {
+        // No equilibrium from this start: it stays NaN.
       }
-    } catch (const SettleInterrupted&) {
-      throw;  // the caller stopped the work: not a failed replay
-    } catch (const std::exception&) {
-      // No equilibrium from this start: it stays NaN.
+      out.tried.push_back(tried);
     }
-    out.tried.push_back(tried);
   }
   return out;
 }

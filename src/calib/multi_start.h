@@ -2,10 +2,13 @@
 // optimum: where the baseline absorbed a strong effect into distorted
 // parameters (a strong strain stiffening: k twice the truth, kappa_jam at
 // its bound), a local fit from there stops near the effect's neutral value.
-// So the new parameter is started at points spanning its whole range
-// (log-spaced for a range from zero or a positive bound, evenly otherwise),
-// every parameter refitted jointly from each for a few iterations, and the
-// full local refit starts from the best of them.
+// So each new parameter in turn is started at points spanning its whole
+// range (log-spaced for a range from zero or a positive bound, evenly
+// otherwise), the others where the local fit left them, every parameter
+// refitted jointly from each for a few iterations, and the full local refit
+// starts from the best of them. Several parameters of one effect can trade
+// off into a wrong basin (a strong cell_stiffness: the gradient found, the
+// bulge left near 0 at a fifth of the truth), so each is started apart.
 #pragma once
 
 #include <string>
@@ -16,18 +19,19 @@
 namespace hj {
 
 struct MultiStartOptions {
-  int starts = 4;      // values of the new parameter tried
+  int starts = 4;      // values of each new parameter tried
   int iterations = 2;  // Levenberg-Marquardt iterations from each
 };
 
 struct StartTried {
-  double value = 0.0;     // the new parameter's start
+  std::string parameter;  // qualified name of the parameter started
+  double value = 0.0;     // its start
   double rmse_mm = 0.0;   // after the short joint fit; NaN if it did not replay
-  double fitted = 0.0;    // the new parameter where the short fit stopped
+  double fitted = 0.0;    // that parameter where the short fit stopped
 };
 
 struct MultiStart {
-  std::string parameter;  // qualified name of the parameter started over its range
+  std::string parameter;  // qualified names of the parameters started over their ranges, comma-separated
   std::vector<StartTried> tried;
   ModelParams best;        // the short fit of lowest cost
   double best_sum_sq_mm2 = 0.0;
@@ -39,7 +43,7 @@ struct MultiStart {
 // lower to upper when both are positive, evenly from lower to upper otherwise.
 std::vector<double> range_starts(const ParameterSpec& spec, int starts);
 
-// True for an effect multi_start() applies to: one fitted parameter and
+// True for an effect multi_start() applies to: fitted parameters and
 // forces on the surface (a camera effect is close to linear in its values).
 bool wants_multi_start(const std::string& effect);
 

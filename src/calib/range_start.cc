@@ -22,7 +22,8 @@ void start_from_best_of_range(const Dataset& dataset, const ModelParams& current
     const LeastSquaresResult from_scan = fit_least_squares(dataset, scanned, parameters, short_fit);
     for (const auto& p : parameters)
       if (!p.surface && p.effect == c.added)
-        c.starts_tried.push_back({parameter_value(scanned, p), from_scan.rmse_mm, parameter_value(from_scan.params, p)});
+        c.starts_tried.push_back(
+            {p.qualified_name(), parameter_value(scanned, p), from_scan.rmse_mm, parameter_value(from_scan.params, p)});
     if (from_scan.sum_sq_mm2 <= range.best_sum_sq_mm2) {
       c.scanned_start = from_scan.params;
       range.found = false;
