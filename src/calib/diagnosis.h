@@ -84,9 +84,9 @@ struct DiagnoseOptions {
   // six others at 1.5-1.7 x, and their refits cost two thirds of the run).
   double refit_cutoff_explained = 1.3;
   EffectScanOptions scan_options;
-  // A refitted candidate with one parameter whose local refit leaves the
-  // data unexplained (goodness below) is looked at over that parameter's
-  // whole range: short joint fits from values spanning it (multi_start.h),
+  // A refitted candidate whose local refit leaves the data unexplained
+  // (goodness below) is looked at over each of its parameters' whole
+  // ranges: short joint fits from values spanning them (multi_start.h),
   // and if one already beats the local fit, a full refit from there, the
   // better kept. starts = 0: the local refit only.
   MultiStartOptions multi_start{4, 2};
