@@ -18,6 +18,23 @@ namespace fs = std::filesystem;
 
 const fs::path kBaseline = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline";
 
+// Two of demo-baseline's sessions, its true baseline and a short fit's options.
+Dataset two_sessions() { return select_sessions(read_dataset(kBaseline), {"unjammed-sweep", "mixed-1"}, true); }
+
+ModelParams true_baseline() {
+  ModelParams start;
+  start.surface.mass_kg = 0.52;
+  start.surface.spring_k = 58.0;
+  start.surface.kappa_jam = 4.2;
+  return start;
+}
+
+LeastSquaresOptions eight_iterations() {
+  LeastSquaresOptions options;
+  options.max_iterations = 8;
+  return options;
+}
+
 double cost_without(const Dataset& d, int held_out, const ModelParams& params, const ReplayOptions& options) {
   double cost = 0.0;
   for (int s = 0; s < static_cast<int>(d.sessions.size()); ++s)
@@ -26,15 +43,10 @@ double cost_without(const Dataset& d, int held_out, const ModelParams& params, c
 }
 
 TEST(CrossValidation, AFoldThatLeapsIsCutBackToWhereItFitsItsTrainingSessions) {
-  const Dataset d = select_sessions(read_dataset(kBaseline), {"unjammed-sweep", "mixed-1"}, true);
-  ModelParams start;
-  start.surface.mass_kg = 0.52;
-  start.surface.spring_k = 58.0;
-  start.surface.kappa_jam = 4.2;
-  LeastSquaresOptions options;
-  options.max_iterations = 8;
+  const Dataset d = two_sessions();
+  const LeastSquaresOptions options = eight_iterations();
   const auto parameters = fit_parameters({});
-  LeastSquaresResult fit = fit_least_squares(d, start, parameters, options);
+  LeastSquaresResult fit = fit_least_squares(d, true_baseline(), parameters, options);
   ASSERT_GE(fit.active.size(), 2u);
 
   // The fit's own linearisation: each fold stays close to the optimum, and
@@ -77,15 +89,10 @@ TEST(CrossValidation, AFoldThatLeapsIsCutBackToWhereItFitsItsTrainingSessions) {
 // held-out session, and where the model is close to linear its held-out
 // error is what the one-step fold predicts.
 TEST(CrossValidation, AFoldRefitIsTheFitWithoutItsSession) {
-  const Dataset d = select_sessions(read_dataset(kBaseline), {"unjammed-sweep", "mixed-1"}, true);
-  ModelParams start;
-  start.surface.mass_kg = 0.52;
-  start.surface.spring_k = 58.0;
-  start.surface.kappa_jam = 4.2;
-  LeastSquaresOptions options;
-  options.max_iterations = 8;
+  const Dataset d = two_sessions();
+  const LeastSquaresOptions options = eight_iterations();
   const auto parameters = fit_parameters({});
-  const LeastSquaresResult fit = fit_least_squares(d, start, parameters, options);
+  const LeastSquaresResult fit = fit_least_squares(d, true_baseline(), parameters, options);
   const CrossValidation one_step = cross_validate(d, parameters, fit, options.replay);
   for (int s = 0; s < static_cast<int>(d.sessions.size()); ++s) {
     const FoldRefit fold = refit_fold(d, parameters, fit, s, options);
