@@ -10,6 +10,7 @@
 #include "calib/cross_validation.h"
 #include "calib/fit_model.h"
 #include "calib/fold_refit.h"
+#include "calib_synthetic.h"
 
 namespace hj {
 namespace {
@@ -18,16 +19,9 @@ namespace fs = std::filesystem;
 
 const fs::path kBaseline = fs::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline";
 
-// Two of demo-baseline's sessions, its true baseline and a short fit's options.
+// Two of demo-baseline's sessions and a short fit's options; the start is
+// demo-baseline's true baseline (calib_synthetic.h).
 Dataset two_sessions() { return select_sessions(read_dataset(kBaseline), {"unjammed-sweep", "mixed-1"}, true); }
-
-ModelParams true_baseline() {
-  ModelParams start;
-  start.surface.mass_kg = 0.52;
-  start.surface.spring_k = 58.0;
-  start.surface.kappa_jam = 4.2;
-  return start;
-}
 
 LeastSquaresOptions eight_iterations() {
   LeastSquaresOptions options;
@@ -46,7 +40,7 @@ TEST(CrossValidation, AFoldThatLeapsIsCutBackToWhereItFitsItsTrainingSessions) {
   const Dataset d = two_sessions();
   const LeastSquaresOptions options = eight_iterations();
   const auto parameters = fit_parameters({});
-  LeastSquaresResult fit = fit_least_squares(d, true_baseline(), parameters, options);
+  LeastSquaresResult fit = fit_least_squares(d, testing_support::true_tiny_baseline(), parameters, options);
   ASSERT_GE(fit.active.size(), 2u);
 
   // The fit's own linearisation: each fold stays close to the optimum, and
@@ -92,7 +86,7 @@ TEST(CrossValidation, AFoldRefitIsTheFitWithoutItsSession) {
   const Dataset d = two_sessions();
   const LeastSquaresOptions options = eight_iterations();
   const auto parameters = fit_parameters({});
-  const LeastSquaresResult fit = fit_least_squares(d, true_baseline(), parameters, options);
+  const LeastSquaresResult fit = fit_least_squares(d, testing_support::true_tiny_baseline(), parameters, options);
   const CrossValidation one_step = cross_validate(d, parameters, fit, options.replay);
   for (int s = 0; s < static_cast<int>(d.sessions.size()); ++s) {
     const FoldRefit fold = refit_fold(d, parameters, fit, s, options);
