@@ -30,8 +30,7 @@ SignificanceTests significance_tests(const CandidateFit& c, const Selection& s) 
 }
 
 bool is_significant(const CandidateFit& c, const Selection& s) {
-  const SignificanceTests t = significance_tests(c, s);
-  return t.heldout && t.bic && t.fit && t.material;
+  return significance_tests(c, s).all();
 }
 
 void refit_fold_of(Selection& s, const std::vector<FitParameter>& parameters, int k, CandidateFit& c) {
@@ -134,8 +133,7 @@ void probe_if_unexplained(const Selection& s, const std::vector<FitParameter>& p
 // Says so in notes where a candidate passes every test except the share of
 // the misfit above the floor it removes: the user sees it was weighed.
 void note_if_immaterial(Selection& s, const CandidateFit& c) {
-  const SignificanceTests t = significance_tests(c, s);
-  if (!t.heldout || !t.bic || !t.fit || t.material) return;
+  if (!significance_tests(c, s).only_material_fails()) return;
   char note[300];
   std::snprintf(note, sizeof note,
                 "%s lowers the error (RMSE %.4f -> %.4f mm) but removes only %.0f %% of the misfit above the noise "
@@ -150,8 +148,7 @@ void note_if_immaterial(Selection& s, const CandidateFit& c) {
 // refitted for real (fold_refit.h), the worst first, until it passes, at
 // most max_fold_refits of them. Says so in notes.
 void refit_deciding_folds(Selection& s, const std::vector<FitParameter>& parameters, CandidateFit& c) {
-  const SignificanceTests t = significance_tests(c, s);
-  if (t.heldout || !t.bic || !t.fit || !t.material) return;
+  if (!significance_tests(c, s).only_heldout_fails()) return;
   const std::vector<int>& rows = c.fit.session_rows;
   const int sessions = static_cast<int>(c.heldout_session_rmse_mm.size());
   if (static_cast<int>(rows.size()) != sessions + 1 || c.fit.residuals.size() != rows.back()) return;

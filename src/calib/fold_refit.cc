@@ -2,21 +2,20 @@
 
 #include <cmath>
 
+#include "calib/dataset.h"
 #include "calib/residuals.h"
 
 namespace hj {
 
 FoldRefit refit_fold(const Dataset& dataset, const std::vector<FitParameter>& parameters,
                      const LeastSquaresResult& fit, int held_out, const LeastSquaresOptions& options) {
-  Dataset training{dataset.dir, {}};
-  for (int s = 0; s < static_cast<int>(dataset.sessions.size()); ++s)
-    if (s != held_out) training.sessions.push_back(dataset.sessions[s]);
+  const MeasuredSession& held = dataset.sessions[held_out];
+  const Dataset training = select_sessions(dataset, {held.session.name}, false);
   FoldRefit out;
   out.params = fit_least_squares(training, fit.params, parameters, options).params;
-  const Eigen::VectorXd r = session_residuals(dataset.sessions[held_out], out.params, options.replay);
-  out.heldout_sum_sq_mm2 = r.squaredNorm();
+  const Eigen::VectorXd r = session_residuals(held, out.params, options.replay);
   out.heldout_count = static_cast<long>(r.size());
-  out.heldout_rmse_mm = r.size() ? std::sqrt(out.heldout_sum_sq_mm2 / r.size()) : 0.0;
+  out.heldout_rmse_mm = r.size() ? std::sqrt(r.squaredNorm() / r.size()) : 0.0;
   return out;
 }
 

@@ -14,10 +14,9 @@
 namespace hj {
 
 struct FoldRefit {
-  ModelParams params;        // the fold's refitted parameters
-  double heldout_rmse_mm;    // the held-out session replayed there
-  double heldout_sum_sq_mm2;
-  long heldout_count;
+  ModelParams params;           // the fold's refitted parameters
+  double heldout_rmse_mm = 0.0; // the held-out session replayed there
+  long heldout_count = 0;       // its samples
 };
 
 // Fits `parameters` on every session of `dataset` but `held_out`, from

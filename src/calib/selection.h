@@ -41,6 +41,10 @@ struct SignificanceTests {
   bool bic = false;       // delta BIC below max_delta_bic
   bool fit = false;       // the in-sample RMSE falls by min_fit_gain, or delta BIC below strong_delta_bic
   bool material = false;  // min_excess_share of the misfit above the floor removed
+  bool all() const { return heldout && bic && fit && material; }
+  // All but the held-out test pass / all but materiality pass.
+  bool only_heldout_fails() const { return !heldout && bic && fit && material; }
+  bool only_material_fails() const { return heldout && bic && fit && !material; }
 };
 SignificanceTests significance_tests(const CandidateFit& c, const Selection& s);
 bool is_significant(const CandidateFit& c, const Selection& s);
