@@ -12,6 +12,11 @@
 
 namespace hj {
 
+double excess_mm2(const LeastSquaresResult& fit, const Selection& s) {
+  const double floor = s.out.noise_floor_mm;
+  return std::max(0.0, fit.rmse_mm * fit.rmse_mm - floor * floor);
+}
+
 double excess_share_removed(const CandidateFit& c, const Selection& s) {
   const double floor2 = s.out.noise_floor_mm * s.out.noise_floor_mm;
   const double excess = s.current.rmse_mm * s.current.rmse_mm - floor2;
@@ -31,6 +36,12 @@ SignificanceTests significance_tests(const CandidateFit& c, const Selection& s) 
 
 bool is_significant(const CandidateFit& c, const Selection& s) {
   return significance_tests(c, s).all();
+}
+
+bool worth_a_basin_search(const Selection& s, const CandidateFit& c) {
+  if (s.round_explained || goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) return false;
+  const double ratio = s.options.search_excess_ratio;
+  return !(ratio > 0.0 && excess_mm2(c.fit, s) > ratio * s.round_best_excess_mm2);
 }
 
 void refit_fold_of(Selection& s, const std::vector<FitParameter>& parameters, int k, CandidateFit& c) {
@@ -102,7 +113,7 @@ void outrun(CandidateFit& c, const LeastSquaresResult& current, double best_held
 // a significant candidate already does, costs nothing more.
 void refit_over_range_if_unexplained(const Selection& s, const std::vector<FitParameter>& parameters,
                                      const LeastSquaresProgress& progress, CandidateFit& c) {
-  if (s.round_explained || goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) return;
+  if (!worth_a_basin_search(s, c)) return;
   const std::optional<ModelParams> start = better_start_than_local(s.dataset, c.fit, s.options, s.progress, c);
   if (!start) return;
   CandidateFit from_range = c;
@@ -121,7 +132,7 @@ void refit_over_range_if_unexplained(const Selection& s, const std::vector<FitPa
 // as a fit's optimum is (optimum_probe.h), and refitted from a better point.
 void probe_if_unexplained(const Selection& s, const std::vector<FitParameter>& parameters, const std::string& stage,
                           CandidateFit& c) {
-  if (s.round_explained || goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) return;
+  if (!worth_a_basin_search(s, c)) return;
   const FitProgress progress = [&](const std::string& step, int done, int total, const std::string& detail) {
     if (s.progress) s.progress(stage + ": " + step, done, total, detail);
   };
@@ -168,67 +179,143 @@ void refit_deciding_folds(Selection& s, const std::vector<FitParameter>& paramet
   }
 }
 
-// Refits one candidate from the current optimum, cross-validates it and
-// judges it; false (and said so in out.skipped) if the model cannot replay it.
-bool refit_candidate(Selection& s, const std::string& on, CandidateFit& c) {
-  const std::string& effect = c.added;
+// Cross-validates c's fit and judges it against the current model.
+void judge(Selection& s, const std::vector<FitParameter>& parameters, CandidateFit& c) {
+  if (s.progress) s.progress("cross-validation", 0, 1, c.added);
+  cross_validate_candidate(s.dataset, parameters, s.options.fit.least_squares.replay, c);
+  c.delta_bic = bic(c.fit) - bic(s.current);
+  refit_deciding_folds(s, parameters, c);
+  c.significant = is_significant(c, s);
+}
+
+// One progress stage per candidate, so that its time shows apart.
+std::string stage_of(const Selection& s, const CandidateFit& c) {
+  std::string on;
+  for (const auto& e : s.chosen) on += " + " + e;
+  return "candidate " + c.added + (on.empty() ? "" : " on baseline" + on);
+}
+
+void report_done(const Selection& s, const CandidateFit& c) {
+  const int cap = s.options.fit.least_squares.max_iterations;
+  if (s.progress) s.progress(stage_of(s, c), cap, cap, "held out " + std::to_string(c.heldout_rmse_mm) + " mm");
+}
+
+// Refits one candidate from the current optimum (or where the scan or the
+// short fits over its range found it best), cross-validates it and judges
+// it; false (and said so in out.skipped) if the model cannot replay it.
+bool refit_locally(Selection& s, CandidateFit& c) {
   const auto parameters = fit_parameters(c.effects);
-  // One progress stage per candidate, so that its time shows apart.
-  const std::string stage = "candidate " + effect + (on.empty() ? "" : " on baseline" + on);
-  const DiagnoseProgress& progress = s.progress;
-  // Warm start: the current model's optimum, the new effect where the scan
-  // found it best, or where the best short fit over its range ended.
+  const std::string stage = stage_of(s, c);
   try {
-    const LeastSquaresProgress fit_progress = least_squares_progress(progress, stage);
-    if (s.options.multi_start_before_refit) start_from_best_of_range(s.dataset, s.current.params, s.options, progress, c);
-    c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options, fit_progress);
-    if (!s.options.multi_start_before_refit) refit_over_range_if_unexplained(s, parameters, fit_progress, c);
-    probe_if_unexplained(s, parameters, stage, c);
-    if (progress) progress("cross-validation", 0, 1, effect);
-    cross_validate_candidate(s.dataset, parameters, s.options.fit.least_squares.replay, c);
-    c.delta_bic = bic(c.fit) - bic(s.current);
-    refit_deciding_folds(s, parameters, c);
-    c.significant = is_significant(c, s);
-    note_if_immaterial(s, c);
+    if (s.options.multi_start_before_refit) start_from_best_of_range(s.dataset, s.current.params, s.options, s.progress, c);
+    c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options, least_squares_progress(s.progress, stage));
+    judge(s, parameters, c);
   } catch (const SettleInterrupted&) {
     throw;  // the caller stopped the work: not a failed replay
   } catch (const std::exception& e) {
-    s.out.skipped.push_back(effect + ": " + e.what());
+    s.out.skipped.push_back(c.added + ": " + e.what());
     return false;
   }
-  if (progress)
-    progress(stage, s.options.fit.least_squares.max_iterations, s.options.fit.least_squares.max_iterations,
-             "held out " + std::to_string(c.heldout_rmse_mm) + " mm");
+  report_done(s, c);
   return true;
+}
+
+// Searches a locally refitted candidate for a better basin where that is
+// worth it (worth_a_basin_search), and judges it again if one is found; a
+// search the model cannot replay leaves the local refit as it was. True if
+// it searched.
+bool search_for_a_better_basin(Selection& s, CandidateFit& c) {
+  if (!worth_a_basin_search(s, c)) return false;
+  const auto parameters = fit_parameters(c.effects);
+  const std::string stage = stage_of(s, c);
+  CandidateFit searched = c;
+  try {
+    if (!s.options.multi_start_before_refit)
+      refit_over_range_if_unexplained(s, parameters, least_squares_progress(s.progress, stage), searched);
+    probe_if_unexplained(s, parameters, stage, searched);
+    if (!(searched.fit.sum_sq_mm2 < c.fit.sum_sq_mm2)) {
+      searched.fit = std::move(c.fit);  // the local refit and its judgement stand; the starts tried are kept
+      c = std::move(searched);
+      return true;
+    }
+    judge(s, parameters, searched);
+  } catch (const SettleInterrupted&) {
+    throw;  // the caller stopped the work: not a failed replay
+  } catch (const std::exception&) {
+    return true;  // the local refit stands
+  }
+  c = std::move(searched);
+  report_done(s, c);
+  return true;
+}
+
+// The lowest RMSE a candidate is known to reach: its local refit's, or
+// where the screening or the scan saw lower (a strong effect whose local
+// refit stayed in the current model's basin), that.
+double evidence_rmse(const CandidateFit& c) { return std::min(c.fit.rmse_mm, expected_rmse(c)); }
+
+// The round's state after c was judged: whether a significant candidate
+// explains the data, the least misfit one leaves, the best held-out RMSE.
+void note_in_round(Selection& s, const CandidateFit& c, double& best_heldout, std::string& best) {
+  if (!c.significant) return;
+  if (goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) s.round_explained = true;
+  s.round_best_excess_mm2 = std::min(s.round_best_excess_mm2, excess_mm2(c.fit, s));
+  if (c.heldout_rmse_mm < best_heldout) best_heldout = c.heldout_rmse_mm, best = c.added;
 }
 
 }  // namespace
 
+// Two passes: every candidate refitted locally, the one that leads the
+// round searched at once (its result sets the cutoff for the others), then
+// the searches of the rest, the best evidence first, at most
+// max_basin_searches in the round, so that whether a candidate is searched
+// does not hang on the order of the refits.
 void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits) {
-  std::string on;
-  for (const auto& e : s.chosen) on += " + " + e;
   std::stable_sort(to_refit.begin(), to_refit.end(), [](const CandidateFit& a, const CandidateFit& b) {
     return expected_rmse(a) < expected_rmse(b);
   });
   double best_heldout = std::numeric_limits<double>::infinity();
+  std::string best;
   s.round_explained = false;
+  s.round_best_excess_mm2 = std::numeric_limits<double>::infinity();
+  int searches = 0;
+  std::vector<CandidateFit> refitted;
+  std::vector<char> searched;
   for (CandidateFit& c : to_refit) {
     const double cutoff = s.round_explained ? s.options.refit_cutoff_explained : s.options.refit_cutoff;
     if (s.options.screening && s.options.refit_cutoff > 0.0 && expected_rmse(c) > cutoff * best_heldout) {
-      outrun(c, s.current, best_heldout, fits.front().added);
+      outrun(c, s.current, best_heldout, best);
       fits.push_back(std::move(c));
       continue;
     }
-    if (!refit_candidate(s, on, c)) continue;
-    if (c.significant && goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained)
-      s.round_explained = true;
-    if (c.significant && c.heldout_rmse_mm < best_heldout) {
-      best_heldout = c.heldout_rmse_mm;
-      fits.insert(fits.begin(), std::move(c));
-    } else {
-      fits.push_back(std::move(c));
-    }
+    if (!refit_locally(s, c)) continue;
+    const bool leads = c.significant && excess_mm2(c.fit, s) < s.round_best_excess_mm2;
+    const bool now = leads && searches < s.options.max_basin_searches && search_for_a_better_basin(s, c);
+    searches += now;
+    note_in_round(s, c, best_heldout, best);
+    refitted.push_back(std::move(c));
+    searched.push_back(now);
   }
+  std::vector<int> order;
+  for (int k = 0; k < static_cast<int>(refitted.size()); ++k)
+    if (!searched[k]) order.push_back(k);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return evidence_rmse(refitted[a]) < evidence_rmse(refitted[b]); });
+  for (int k : order) {
+    if (searches >= s.options.max_basin_searches) break;
+    searches += search_for_a_better_basin(s, refitted[k]);
+    note_in_round(s, refitted[k], best_heldout, best);
+  }
+  for (const CandidateFit& c : refitted) note_if_immaterial(s, c);
+  // The best significant refit first.
+  auto first = std::min_element(refitted.begin(), refitted.end(), [](const CandidateFit& a, const CandidateFit& b) {
+    if (a.significant != b.significant) return a.significant;
+    return a.heldout_rmse_mm < b.heldout_rmse_mm;
+  });
+  const bool lead = first != refitted.end() && first->significant;
+  if (lead) std::rotate(refitted.begin(), first, first + 1);
+  fits.insert(lead ? fits.begin() : fits.end(), std::make_move_iterator(refitted.begin()),
+              std::make_move_iterator(refitted.end()));
 }
 
 bool refit_from_rebased_current(Selection& s, CandidateFit& c) {

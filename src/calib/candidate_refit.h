@@ -1,7 +1,7 @@
 // Refitting the candidates of one round of diagnose's selection
 // (selection.h): the most promising first, each from the current optimum
-// (or the scan's start), searched over its parameter's range where the
-// local refit leaves the data unexplained, then cross-validated and judged.
+// (or the scan's start), cross-validated and judged, then searched over its
+// parameters' ranges where the local refit leaves the data unexplained.
 #pragma once
 
 #include <vector>
@@ -12,8 +12,10 @@ namespace hj {
 
 // Refits the candidates the screening let through, the most promising
 // first, so that one that cannot come near the best refitted one need not
-// be refitted (refit_cutoff, refit_cutoff_explained). fits.front() is the
-// best significant refit; a candidate the model cannot replay is said so in
+// be refitted (refit_cutoff, refit_cutoff_explained); then searches the
+// unexplained ones for a better basin where that may pay (selection.h,
+// worth_a_basin_search; max_basin_searches). fits.front() is the best
+// significant refit; a candidate the model cannot replay is said so in
 // out.skipped.
 void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits);
 

@@ -239,20 +239,29 @@ CandidateFit scanned_candidate(const Selection& s, const std::string& effect, do
   return c;
 }
 
+// The sum of squares under which a cell effect's best cells are fitted:
+// the one that leaves search_excess_ratio times the misfit above the floor
+// that the best scan so far (`best_scan_sum_sq`) leaves.
+double refine_cells_below(const Selection& s, double best_scan_sum_sq) {
+  const double ratio = s.options.search_excess_ratio;
+  if (!(ratio > 0.0) || !std::isfinite(best_scan_sum_sq)) return std::numeric_limits<double>::infinity();
+  const double n = static_cast<double>(std::max(s.current.residual_count, 1L));
+  const double floor_sum_sq = n * s.out.noise_floor_mm * s.out.noise_floor_mm;
+  return floor_sum_sq + ratio * std::max(0.0, best_scan_sum_sq - floor_sum_sq);
+}
+
 // Scans and screens each remaining effect: those the screening keeps out go
 // to `fits` with their predicted figures, the others to `to_refit`. The
 // cell effects go last: their search's short fits, the dearest part of a
-// scan, are paid for only where no other effect's scan already reached a
-// sum of squares refit_cutoff^2 times lower (a strong bending: -80 % against
-// a cell's -4 %, 160 of 720 CPU s in two rounds).
+// scan, are paid for only where no other effect's scan already left
+// search_excess_ratio times less misfit above the floor (a strong bending:
+// -80 % against a cell's -4 %, 160 of 720 CPU s in two rounds).
 void scan_and_screen(const Selection& s, std::vector<std::string> remaining, std::vector<CandidateFit>& fits,
                      std::vector<CandidateFit>& to_refit) {
   std::stable_partition(remaining.begin(), remaining.end(), [](const std::string& e) { return !is_cell_effect(e); });
   double best_scan_sum_sq = std::numeric_limits<double>::infinity();
   for (const auto& effect : remaining) {
-    const double refine_below = s.options.refit_cutoff > 0.0
-                                    ? s.options.refit_cutoff * s.options.refit_cutoff * best_scan_sum_sq
-                                    : std::numeric_limits<double>::infinity();
+    const double refine_below = refine_cells_below(s, best_scan_sum_sq);
     CandidateFit c = scanned_candidate(s, effect, refine_below);
     if (std::isfinite(c.scan_rmse_mm))
       best_scan_sum_sq = std::min(best_scan_sum_sq, c.scan_rmse_mm * c.scan_rmse_mm * s.current.residual_count);

@@ -90,6 +90,16 @@ struct DiagnoseOptions {
   // and if one already beats the local fit, a full refit from there, the
   // better kept. starts = 0: the local refit only.
   MultiStartOptions multi_start{4, 2};
+  // ... and probed (optimum_probe.h). Neither search, nor a cell effect's
+  // short fits of its best cells (cell_search.h), is paid for where another
+  // candidate already leaves search_excess_ratio times less misfit above
+  // the noise floor (RMSE^2 - floor^2): a significant one refitted in the
+  // round, or for the cells, another effect's scan. 0: always searched.
+  double search_excess_ratio = 2.0;
+  // At most this many candidates of a round are searched so (the one that
+  // leads the round first, then the rest by the lowest RMSE their refit,
+  // scan or screening reached): each search costs about a refit.
+  int max_basin_searches = 3;
   // The short fits before every such refit instead, from the range and the
   // scan's start (range_start.h), explained or not.
   bool multi_start_before_refit = false;

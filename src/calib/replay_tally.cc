@@ -11,7 +11,7 @@ void ReplayTally::add(const std::string& session, double cpu_s, bool ok) {
     if (e.session == session) entry = &e;
   if (!entry) entry = &entries_.emplace_back(Entry{session});
   ++entry->replays;
-  if (!ok) ++entry->failed;
+  if (!ok) ++entry->failed, entry->failed_cpu_s += cpu_s;
   entry->cpu_s += cpu_s;
 }
 

@@ -16,6 +16,7 @@ class ReplayTally {
     long replays = 0;
     long failed = 0;     // replays that threw (no equilibrium)
     double cpu_s = 0.0;  // thread CPU time of all its replays
+    double failed_cpu_s = 0.0;  // ... of which in the failed ones
   };
 
   // Thread-safe.

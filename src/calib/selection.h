@@ -3,6 +3,7 @@
 // Internal to diagnose.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct Selection {
   // A significant candidate refitted in this round already explains the
   // data (goodness of fit): the others need no search over their ranges.
   bool round_explained = false;
+  // The least misfit above the noise floor (RMSE^2 - floor^2, mm^2) that a
+  // significant candidate refitted in this round leaves.
+  double round_best_excess_mm2 = std::numeric_limits<double>::infinity();
 };
 
 // Significance. BIC's penalty is ln n per parameter (about 12 for the
@@ -57,5 +61,14 @@ void refit_fold_of(Selection& s, const std::vector<FitParameter>& parameters, in
 // floor^2) that c's fit removes; 1 where the current model is at or below
 // the floor (then there is no misfit to share out).
 double excess_share_removed(const CandidateFit& c, const Selection& s);
+
+// A fit's misfit above the noise floor: RMSE^2 - floor^2 (mm^2), at least 0.
+double excess_mm2(const LeastSquaresResult& fit, const Selection& s);
+
+// Whether c's local refit is worth a search for a better basin (a range
+// search, an optimum probe): it leaves the data unexplained, no significant
+// candidate of the round explains them, and none leaves a misfit above the
+// floor search_excess_ratio times smaller than c's (DiagnoseOptions).
+bool worth_a_basin_search(const Selection& s, const CandidateFit& c);
 
 }  // namespace hj
