@@ -1,7 +1,7 @@
 // Which refitted candidates diagnose searches for a better basin (a range
-// search, an optimum probe; calib/selection.h): an unexplained one, unless
-// a significant candidate of its round leaves far less misfit above the
-// noise floor (DiagnoseOptions::search_excess_ratio).
+// search, an optimum probe, its earlier optimum; calib/selection.h): an
+// unexplained one, unless a significant candidate of its round leaves far
+// less misfit above the noise floor (DiagnoseOptions::search_excess_ratio).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -61,6 +61,14 @@ TEST(BasinSearch, AnExplainedCandidateOrRoundIsNotSearched) {
       << "its local refit already explains the data";
   round.selection.round_explained = true;
   EXPECT_FALSE(worth_a_basin_search(round.selection, candidate_at(1.8)));
+}
+
+TEST(BasinSearch, FromAnEarlierOptimumOnlyResidualsThatAreTheSensorsNoiseAreEnough) {
+  // 1.02 mm against a 1 mm floor is within the floor's tolerance, but over
+  // 1e5 samples chi-square rejects it: a better basin may exist.
+  Round round;
+  EXPECT_TRUE(worth_a_basin_search(round.selection, candidate_at(1.02), true));
+  EXPECT_FALSE(worth_a_basin_search(round.selection, candidate_at(1.0), true));  // chi-square p about 0.5
 }
 
 }  // namespace

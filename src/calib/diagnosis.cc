@@ -358,6 +358,13 @@ std::vector<std::string> effects_for_next_round(const std::vector<CandidateFit>&
 // The chosen model's residuals pass the chi-square test against the
 // sensor's noise itself (not only the floor's tolerance): no further effect
 // can lower the held-out error by a real margin, so no round is run for one.
+// The optima of the significant candidates not chosen (fits.front() is),
+// starts for their searches in later rounds.
+void remember_earlier_optima(const std::vector<CandidateFit>& fits, Selection& s) {
+  for (size_t k = 1; k < fits.size(); ++k)
+    if (fits[k].significant && !fits[k].screened_out) s.earlier_optima[fits[k].added] = fits[k].fit.params;
+}
+
 bool leaves_only_noise(const Selection& s) {
   const GoodnessOfFit g = goodness_of_fit(s.current, s.out.noise_floor_mm, s.options.goodness);
   if (g.p_value < s.options.goodness.alpha) return false;
@@ -402,6 +409,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
     record.insert(record.end(), fits.begin(), fits.end());
     if (!chosen_one) break;
     const CandidateFit& best = fits.front();
+    remember_earlier_optima(fits, s);
     remaining = effects_for_next_round(fits, best, s.current_heldout);
     s.chosen.push_back(best.added);
     s.current = best.fit;

@@ -36,6 +36,10 @@ MultiStart multi_start(const Dataset& dataset, const ModelParams& start, const s
   MultiStart out;
   LeastSquaresOptions short_fit = fit;
   short_fit.max_iterations = options.iterations;
+  // A start is only a start: one that only the simulator's fallbacks could
+  // settle is skipped, as the scan's points are, and fails in a fraction of
+  // the time (a failed replay with them cost 20-40 good ones).
+  short_fit.replay.fallbacks = false;
   out.best_sum_sq_mm2 = std::numeric_limits<double>::infinity();
   for (const auto& parameter : parameters) {
     if (parameter.surface || parameter.effect != effect) continue;

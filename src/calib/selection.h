@@ -4,6 +4,7 @@
 #pragma once
 
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct Selection {
   // The least misfit above the noise floor (RMSE^2 - floor^2, mm^2) that a
   // significant candidate refitted in this round leaves.
   double round_best_excess_mm2 = std::numeric_limits<double>::infinity();
+  // Each candidate's optimum from the last round where it was significant
+  // and not chosen: a start for its search in a later round.
+  std::map<std::string, ModelParams> earlier_optima;
 };
 
 // Significance. BIC's penalty is ln n per parameter (about 12 for the
@@ -69,6 +73,10 @@ double excess_mm2(const LeastSquaresResult& fit, const Selection& s);
 // search, an optimum probe): it leaves the data unexplained, no significant
 // candidate of the round explains them, and none leaves a misfit above the
 // floor search_excess_ratio times smaller than c's (DiagnoseOptions).
-bool worth_a_basin_search(const Selection& s, const CandidateFit& c);
+// strict (a refit from the candidate's earlier optimum, one refit): its
+// residuals failing the chi-square test suffices, whatever the floor's
+// tolerance says (a pressure offset absorbed into the mass left 1.087 mm
+// against a 1.041 floor, within the tolerance).
+bool worth_a_basin_search(const Selection& s, const CandidateFit& c, bool strict = false);
 
 }  // namespace hj
