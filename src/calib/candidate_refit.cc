@@ -279,64 +279,77 @@ bool search_for_a_better_basin(Selection& s, CandidateFit& c) {
 // refit stayed in the current model's basin), that.
 double evidence_rmse(const CandidateFit& c) { return std::min(c.fit.rmse_mm, expected_rmse(c)); }
 
+// The round's bookkeeping beside Selection's: the best held-out RMSE of a
+// significant candidate and its name (the refit cutoff), and the searches
+// for a better basin spent.
+struct RoundTally {
+  double best_heldout = std::numeric_limits<double>::infinity();
+  std::string best;
+  int searches = 0;
+};
+
 // The round's state after c was judged: whether a significant candidate
 // explains the data, the least misfit one leaves, the best held-out RMSE.
-void note_in_round(Selection& s, const CandidateFit& c, double& best_heldout, std::string& best) {
+void note_in_round(Selection& s, const CandidateFit& c, RoundTally& round) {
   if (!c.significant) return;
   if (goodness_of_fit(c.fit, s.out.noise_floor_mm, s.options.goodness).explained) s.round_explained = true;
   s.round_best_excess_mm2 = std::min(s.round_best_excess_mm2, excess_mm2(c.fit, s));
-  if (c.heldout_rmse_mm < best_heldout) best_heldout = c.heldout_rmse_mm, best = c.added;
+  if (c.heldout_rmse_mm < round.best_heldout) round.best_heldout = c.heldout_rmse_mm, round.best = c.added;
 }
 
-}  // namespace
-
-// Two passes: every candidate refitted locally, the one that leads the
-// round searched at once (its result sets the cutoff for the others), then
-// the searches of the rest, the best evidence first, at most
-// max_basin_searches in the round, so that whether a candidate is searched
-// does not hang on the order of the refits.
-void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits) {
+// Refits each candidate locally, the most promising first, unless the
+// refit cutoff rules it out (then it goes to `fits` with its expected
+// figures); the one that leads the round is searched at once, since its
+// result sets the cutoff for the rest. Returns the refitted ones, and in
+// `searched` whether each was searched.
+std::vector<CandidateFit> refit_each_locally(Selection& s, std::vector<CandidateFit>& to_refit,
+                                             std::vector<CandidateFit>& fits, RoundTally& round,
+                                             std::vector<char>& searched) {
   std::stable_sort(to_refit.begin(), to_refit.end(), [](const CandidateFit& a, const CandidateFit& b) {
     return expected_rmse(a) < expected_rmse(b);
   });
-  double best_heldout = std::numeric_limits<double>::infinity();
-  std::string best;
-  s.round_explained = false;
-  s.round_best_excess_mm2 = std::numeric_limits<double>::infinity();
-  int searches = 0;
   std::vector<CandidateFit> refitted;
-  std::vector<char> searched;
   for (CandidateFit& c : to_refit) {
     const double cutoff = s.round_explained ? s.options.refit_cutoff_explained : s.options.refit_cutoff;
-    if (s.options.screening && s.options.refit_cutoff > 0.0 && expected_rmse(c) > cutoff * best_heldout) {
-      outrun(c, s.current, best_heldout, best);
+    if (s.options.screening && s.options.refit_cutoff > 0.0 && expected_rmse(c) > cutoff * round.best_heldout) {
+      outrun(c, s.current, round.best_heldout, round.best);
       fits.push_back(std::move(c));
       continue;
     }
     if (!refit_locally(s, c)) continue;
     const bool leads = c.significant && excess_mm2(c.fit, s) < s.round_best_excess_mm2;
-    const bool now = leads && searches < s.options.max_basin_searches && search_for_a_better_basin(s, c);
-    searches += now;
-    note_in_round(s, c, best_heldout, best);
+    const bool now = leads && round.searches < s.options.max_basin_searches && search_for_a_better_basin(s, c);
+    round.searches += now;
+    note_in_round(s, c, round);
     refitted.push_back(std::move(c));
     searched.push_back(now);
   }
+  return refitted;
+}
+
+// Searches the refitted candidates not searched yet, those significant in
+// an earlier round first (they have shown they can help), then the best
+// evidence, until max_basin_searches are spent.
+void search_the_rest(Selection& s, std::vector<CandidateFit>& refitted, const std::vector<char>& searched,
+                     RoundTally& round) {
   std::vector<int> order;
   for (int k = 0; k < static_cast<int>(refitted.size()); ++k)
     if (!searched[k]) order.push_back(k);
-  // Those significant in an earlier round first: they have shown they can help.
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     const bool ea = s.earlier_optima.count(refitted[a].added) > 0, eb = s.earlier_optima.count(refitted[b].added) > 0;
     if (ea != eb) return ea;
     return evidence_rmse(refitted[a]) < evidence_rmse(refitted[b]);
   });
   for (int k : order) {
-    if (searches >= s.options.max_basin_searches) break;
-    searches += search_for_a_better_basin(s, refitted[k]);
-    note_in_round(s, refitted[k], best_heldout, best);
+    if (round.searches >= s.options.max_basin_searches) break;
+    round.searches += search_for_a_better_basin(s, refitted[k]);
+    note_in_round(s, refitted[k], round);
   }
-  for (const CandidateFit& c : refitted) note_if_immaterial(s, c);
-  // The best significant refit first.
+}
+
+// Moves the refitted candidates into `fits`, the best significant one (the
+// lowest held-out RMSE) at the front.
+void add_best_first(std::vector<CandidateFit>& refitted, std::vector<CandidateFit>& fits) {
   auto first = std::min_element(refitted.begin(), refitted.end(), [](const CandidateFit& a, const CandidateFit& b) {
     if (a.significant != b.significant) return a.significant;
     return a.heldout_rmse_mm < b.heldout_rmse_mm;
@@ -345,6 +358,23 @@ void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::ve
   if (lead) std::rotate(refitted.begin(), first, first + 1);
   fits.insert(lead ? fits.begin() : fits.end(), std::make_move_iterator(refitted.begin()),
               std::make_move_iterator(refitted.end()));
+}
+
+}  // namespace
+
+// Two passes: every candidate refitted locally (the round's leader searched
+// at once), then the searches of the rest, at most max_basin_searches in the
+// round, so that whether a candidate is searched does not hang on the order
+// of the refits.
+void refit_candidates(Selection& s, std::vector<CandidateFit>& to_refit, std::vector<CandidateFit>& fits) {
+  s.round_explained = false;
+  s.round_best_excess_mm2 = std::numeric_limits<double>::infinity();
+  RoundTally round;
+  std::vector<char> searched;
+  std::vector<CandidateFit> refitted = refit_each_locally(s, to_refit, fits, round, searched);
+  search_the_rest(s, refitted, searched, round);
+  for (const CandidateFit& c : refitted) note_if_immaterial(s, c);
+  add_best_first(refitted, fits);
 }
 
 bool refit_from_rebased_current(Selection& s, CandidateFit& c) {
