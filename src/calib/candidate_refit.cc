@@ -18,8 +18,7 @@ double excess_mm2(const LeastSquaresResult& fit, const Selection& s) {
 }
 
 double excess_share_removed(const CandidateFit& c, const Selection& s) {
-  const double floor2 = s.out.noise_floor_mm * s.out.noise_floor_mm;
-  const double excess = s.current.rmse_mm * s.current.rmse_mm - floor2;
+  const double excess = excess_mm2(s.current, s);
   if (!(excess > 0.0)) return 1.0;
   return (s.current.rmse_mm * s.current.rmse_mm - c.fit.rmse_mm * c.fit.rmse_mm) / excess;
 }

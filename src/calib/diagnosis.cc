@@ -355,9 +355,6 @@ std::vector<std::string> effects_for_next_round(const std::vector<CandidateFit>&
   return next;
 }
 
-// The chosen model's residuals pass the chi-square test against the
-// sensor's noise itself (not only the floor's tolerance): no further effect
-// can lower the held-out error by a real margin, so no round is run for one.
 // The optima of the significant candidates not chosen (fits.front() is),
 // starts for their searches in later rounds.
 void remember_earlier_optima(const std::vector<CandidateFit>& fits, Selection& s) {
@@ -365,6 +362,9 @@ void remember_earlier_optima(const std::vector<CandidateFit>& fits, Selection& s
     if (fits[k].significant && !fits[k].screened_out) s.earlier_optima[fits[k].added] = fits[k].fit.params;
 }
 
+// The chosen model's residuals pass the chi-square test against the
+// sensor's noise itself (not only the floor's tolerance): no further effect
+// can lower the held-out error by a real margin, so no round is run for one.
 bool leaves_only_noise(const Selection& s) {
   const GoodnessOfFit g = goodness_of_fit(s.current, s.out.noise_floor_mm, s.options.goodness);
   if (g.p_value < s.options.goodness.alpha) return false;
