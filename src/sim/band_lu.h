@@ -30,6 +30,8 @@ class BandLU {
   void solve(const Eigen::VectorXd& r, Eigen::VectorXd& dx) const;
 
   int half_bandwidth() const { return bandwidth_; }
+  // The position of row / column i of the analysed matrix in the band.
+  int ordered_index(int i) const { return new_of_[i]; }
 
  private:
   int n_ = 0;
