@@ -3,9 +3,11 @@
 // whose captures at 2.16 and 3.02 kPa take another shape below about
 // 0.51993 kg (the truth is 0.52). A fit of the mass from the levelling
 // estimate's 0.51977 converges in that basin; the probe finds the better
-// one, and a fit from there reaches the truth's cost.
+// one, and a fit from there reaches the truth's cost. Its replays stop
+// once their cost is past what it could take.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "calib/optimum_probe.h"
@@ -104,6 +106,27 @@ TEST(OptimumProbe, StaysAtAnOptimumWithNothingBetterNearby) {
   EXPECT_FALSE(probe.moved) << probe.note;
   EXPECT_EQ(probe.best.surface.mass_kg, at_truth.params.surface.mass_kg);
   EXPECT_TRUE(probe.note.empty());
+}
+
+// The probe's replays stop once their cost passes what it could take: a
+// bound above the sum gives the sum itself; one below it stops after the
+// first session (the sessions run one after another) with a value above
+// the bound and no more than the sum.
+TEST(OptimumProbe, AReplayStopsOnceItsCostPassesTheBound) {
+  const Dataset d = select_sessions(read_dataset(kSessions / "demo-baseline"), {"mixed-1", "unjammed-sweep"}, true);
+  ReplayOptions replay = fitting_replay({});
+  ReplayTally whole, cut;
+  replay.tally = &whole;
+  const double sum = dataset_sum_of_squares(d, truth(), replay);
+  ASSERT_TRUE(std::isfinite(sum));
+  EXPECT_EQ(whole.replays(), 2);
+  replay.tally = nullptr;
+  EXPECT_EQ(dataset_sum_of_squares(d, truth(), replay, 1, 1.001 * sum), sum);
+  replay.tally = &cut;
+  const double bounded = dataset_sum_of_squares(d, truth(), replay, 1, 0.1 * sum);
+  EXPECT_GT(bounded, 0.1 * sum);
+  EXPECT_LE(bounded, sum * (1.0 + 1e-9));
+  EXPECT_EQ(cut.replays(), 1) << "the second session is not replayed";
 }
 
 }  // namespace

@@ -39,12 +39,14 @@ OptimumProbe probe_optimum(const Dataset& dataset, const LeastSquaresResult& fit
   out.best = fit.params;
   out.start_sum_sq_mm2 = out.best_sum_sq_mm2 = fit.sum_sq_mm2;
   out.points = static_cast<int>(points.size());
+  // A point above this is never taken, so its replay may stop there.
+  const double worth_taking = (1.0 - options.min_gain) * fit.sum_sq_mm2;
   parallel_for(
       out.points,
       [&](int k) {
         ModelParams at = fit.params;
         set_parameter_value(at, points[k].estimate->parameter, points[k].value);
-        points[k].sum_sq = dataset_sum_of_squares(dataset, at, replay);
+        points[k].sum_sq = dataset_sum_of_squares(dataset, at, replay, 1, worth_taking);
       },
       replay.threads);
   const Point* best = nullptr;

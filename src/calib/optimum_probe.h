@@ -40,7 +40,7 @@ struct OptimumProbe {
   double start_sum_sq_mm2 = 0.0;
   double best_sum_sq_mm2 = 0.0;
   int points = 0;        // whole-dataset replays it cost
-  int failed = 0;        // of them, where the model has no equilibrium
+  int failed = 0;        // of them, where the model has no equilibrium (before passing the cost worth taking)
   std::string note;      // e.g. "mass_kg 0.5198 -> 0.5202 (sum of squares -2.9 %)"
 };
 

@@ -14,7 +14,8 @@ Eigen::VectorXd sample_y_mm(const SessionGrid& grid) {
 
 std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,
                                              const SimulatorOptions& options, const ReplayProgress& progress,
-                                             const ReplayTrace* warm_start, ReplayTrace* trace) {
+                                             const ReplayTrace* warm_start, ReplayTrace* trace,
+                                             const CaptureSink& on_capture) {
   params.max_pressure_pa = session.device.max_pressure_kpa * 1000.0;
   Simulator sim(session.device.geometry(segments), params, options);
   const Eigen::VectorXd x_mm = sample_x_mm(session.grid), y_mm = sample_y_mm(session.grid);
@@ -31,6 +32,7 @@ std::vector<PredictedCapture> replay_session(const Session& session, int segment
       // Measurement effects (a tilted camera) change what the camera reports.
       sim.model().adjust_measurement(x_mm, y_mm, heights);
       captures.push_back({step.index, step.frame, step.label, std::move(heights)});
+      if (on_capture) on_capture(captures.back());
     } else {
       try {
         const Eigen::Matrix3Xd* start = warm_start ? &(*warm_start)[i] : nullptr;

@@ -34,10 +34,15 @@ using ReplayTrace = std::vector<Eigen::Matrix3Xd>;
 Eigen::VectorXd sample_x_mm(const SessionGrid& grid);
 Eigen::VectorXd sample_y_mm(const SessionGrid& grid);
 
+// Called with each capture as the replay makes it; an exception it throws
+// stops the replay and goes to replay_session's caller.
+using CaptureSink = std::function<void(const PredictedCapture& capture)>;
+
 // The session's device with `params` (whose max pressure is replaced by the
 // session's). Throws SessionError naming the step when an action fails.
 std::vector<PredictedCapture> replay_session(const Session& session, int segments, SurfaceParameters params,
                                              const SimulatorOptions& options, const ReplayProgress& progress = {},
-                                             const ReplayTrace* warm_start = nullptr, ReplayTrace* trace = nullptr);
+                                             const ReplayTrace* warm_start = nullptr, ReplayTrace* trace = nullptr,
+                                             const CaptureSink& on_capture = {});
 
 }  // namespace hj

@@ -16,22 +16,50 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Thrown by a capture check to stop a replay whose sum of squares has
+// passed its caller's bound: a replay cut short, not a failed one.
+struct PastBound {};
+
 std::vector<PredictedCapture> predict(const MeasuredSession& session, const ModelParams& params,
                                       const ReplayOptions& options, const ReplayTrace* warm_start = nullptr,
-                                      ReplayTrace* trace = nullptr) {
+                                      ReplayTrace* trace = nullptr, const CaptureSink& on_capture = {}) {
   if (!options.tally)
     return replay_session(session.session, options.segments, params.surface, simulator_options(params, options), {},
-                          warm_start, trace);
+                          warm_start, trace, on_capture);
   const double cpu_start = thread_cpu_seconds();
   try {
     auto out = replay_session(session.session, options.segments, params.surface, simulator_options(params, options),
-                              {}, warm_start, trace);
+                              {}, warm_start, trace, on_capture);
     options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true);
     return out;
+  } catch (const PastBound&) {
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true);
+    throw;
   } catch (...) {
     options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, false);
     throw;
   }
+}
+
+// Adds one capture's squared residuals (as capture_residuals makes them) to
+// `running`, shared by a dataset's sessions, and stops the replay with
+// PastBound once the total passes `bound` (by a relative 1e-9: the running
+// sum adds in another order than the final one, and a sum at the bound
+// must not be cut).
+CaptureSink bound_check(const MeasuredSession& session, std::atomic<double>& running, double bound) {
+  const double limit = bound + 1e-9 * std::abs(bound);
+  return [&session, &running, limit, next = size_t{0}](const PredictedCapture& predicted) mutable {
+    const Eigen::MatrixXd& measured = session.captures.at(next++).heights_mm;
+    double sum = 0.0;
+    for (int iy = 0; iy < measured.rows(); ++iy)
+      for (int ix = 0; ix < measured.cols(); ++ix) {
+        if (std::isnan(measured(iy, ix))) continue;
+        const double p = predicted.heights_mm(iy, ix);
+        const double r = std::isnan(p) ? -measured(iy, ix) : p - measured(iy, ix);
+        sum += r * r;
+      }
+    if (running.fetch_add(sum) + sum > limit) throw PastBound{};
+  };
 }
 
 }  // namespace
@@ -189,18 +217,24 @@ Eigen::VectorXd capture_residuals(const MeasuredSession& session, const std::vec
 }
 
 double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                              int session_threads) {
+                              int session_threads, double bound) {
   ReplayOptions serial = options;
   serial.threads = 1;
   const int n = static_cast<int>(dataset.sessions.size());
   std::vector<double> sums(n, 0.0);
-  std::atomic<bool> failed{false};
+  std::atomic<bool> failed{false}, past_bound{false};
+  std::atomic<double> running{0.0};
+  const bool bounded = bound < std::numeric_limits<double>::infinity();
   parallel_for(
       n,
       [&](int s) {
-        if (failed) return;
+        if (failed || past_bound) return;
+        const MeasuredSession& session = dataset.sessions[s];
         try {
-          sums[s] = session_residuals(dataset.sessions[s], params, serial).squaredNorm();
+          const CaptureSink check = bounded ? bound_check(session, running, bound) : CaptureSink{};
+          sums[s] = capture_residuals(session, predict(session, params, serial, nullptr, nullptr, check)).squaredNorm();
+        } catch (const PastBound&) {
+          past_bound = true;
         } catch (const SettleInterrupted&) {
           throw;  // the caller stopped the work: not a failed replay
         } catch (const std::exception&) {
@@ -209,6 +243,7 @@ double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params,
       },
       std::max(1, session_threads));
   if (failed) return std::numeric_limits<double>::infinity();
+  if (past_bound) return std::max(running.load(), std::nextafter(bound, std::numeric_limits<double>::infinity()));
   double sum = 0.0;
   for (double s : sums) sum += s;  // in session order, whatever the threads
   return sum;

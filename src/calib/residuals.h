@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -124,7 +125,13 @@ Eigen::VectorXd capture_residuals(const MeasuredSession& session, const std::vec
 // no equilibrium. SettleInterrupted is let through.
 // With session_threads > 1 the sessions run on that many threads, for a
 // caller with fewer points than cores.
+// With a bound, the caller needs the sum only where it is at most the
+// bound: once the captures so far pass it, the replays stop and a value
+// above the bound (the sum so far) is returned. A session with no
+// equilibrium after that point is not reached, so it does not make the
+// sum infinite.
 double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                              int session_threads = 1);
+                              int session_threads = 1,
+                              double bound = std::numeric_limits<double>::infinity());
 
 }  // namespace hj
