@@ -16,6 +16,12 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// One sample's least-squares residual; a sample the prediction does not
+// cover is predicted at the rig's clamp level, 0 mm (see residuals.h).
+double sample_residual(double predicted, double measured) {
+  return std::isnan(predicted) ? -measured : predicted - measured;
+}
+
 // Thrown by a capture check to stop a replay whose sum of squares has
 // passed its caller's bound: a replay cut short, not a failed one.
 struct PastBound {};
@@ -54,8 +60,7 @@ CaptureSink bound_check(const MeasuredSession& session, std::atomic<double>& run
     for (int iy = 0; iy < measured.rows(); ++iy)
       for (int ix = 0; ix < measured.cols(); ++ix) {
         if (std::isnan(measured(iy, ix))) continue;
-        const double p = predicted.heights_mm(iy, ix);
-        const double r = std::isnan(p) ? -measured(iy, ix) : p - measured(iy, ix);
+        const double r = sample_residual(predicted.heights_mm(iy, ix), measured(iy, ix));
         sum += r * r;
       }
     if (running.fetch_add(sum) + sum > limit) throw PastBound{};
@@ -208,9 +213,7 @@ Eigen::VectorXd capture_residuals(const MeasuredSession& session, const std::vec
     for (int iy = 0; iy < measured.rows(); ++iy)
       for (int ix = 0; ix < measured.cols(); ++ix) {
         if (std::isnan(measured(iy, ix))) continue;
-        const double p = predicted[c].heights_mm(iy, ix);
-        // Not covered: the rig's clamp level, 0 mm (see residuals.h).
-        out[k++] = std::isnan(p) ? -measured(iy, ix) : p - measured(iy, ix);
+        out[k++] = sample_residual(predicted[c].heights_mm(iy, ix), measured(iy, ix));
       }
   }
   return out;
