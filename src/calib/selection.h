@@ -30,7 +30,7 @@ struct Selection {
   double round_best_excess_mm2 = std::numeric_limits<double>::infinity();
   // Each candidate's optimum from the last round where it was significant
   // and not chosen: a start for its search in a later round.
-  std::map<std::string, ModelParams> earlier_optima;
+  std::map<std::string, ModelParams> earlier_optima = {};
 };
 
 // Significance. BIC's penalty is ln n per parameter (about 12 for the
