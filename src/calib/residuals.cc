@@ -246,7 +246,7 @@ double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params,
       },
       std::max(1, session_threads));
   if (failed) return std::numeric_limits<double>::infinity();
-  if (past_bound) return std::max(running.load(), std::nextafter(bound, std::numeric_limits<double>::infinity()));
+  if (past_bound) return running.load();  // above the bound: the check that stopped it saw so
   double sum = 0.0;
   for (double s : sums) sum += s;  // in session order, whatever the threads
   return sum;
