@@ -74,7 +74,7 @@ TEST(Portfolio, IsNeverBelowAlgorithm2AndSaysWhatItChose) {
 
 TEST(Portfolio, StopsTheOtherStrategiesAtItsTimeBudget) {
   // One thread runs Algorithm 2 first; a budget of a tiny fraction of its
-  // time is spent before any other strategy starts, so each is stopped.
+  // time is spent before any other strategy's turn, so none is started.
   const ArrayGeometry g{2, 3, 0.038, 4};
   const PlanRequest request = volcano_request(g);
   PortfolioOptions options;
@@ -83,9 +83,9 @@ TEST(Portfolio, StopsTheOtherStrategiesAtItsTimeBudget) {
   const PlanResult best = Portfolio(options).plan(request);
   const PlanResult paper = make_planner("algorithm2")->plan(request);
   EXPECT_EQ(best.note.rfind("chose algorithm2;", 0), 0u) << best.note;
-  std::size_t stopped = 0;
-  for (std::size_t at = 0; (at = best.note.find("stopped at the time budget", at)) != std::string::npos; ++at) ++stopped;
-  EXPECT_EQ(stopped, Portfolio::strategies().size() - 1) << best.note;
+  std::size_t skipped = 0;
+  for (std::size_t at = 0; (at = best.note.find("not started", at)) != std::string::npos; ++at) ++skipped;
+  EXPECT_EQ(skipped, Portfolio::strategies().size() - 1) << best.note;
   EXPECT_EQ(best.steps.size(), paper.steps.size());
   EXPECT_LT((best.final_state.x - paper.final_state.x).cwiseAbs().maxCoeff(), 1e-9);
 }
@@ -127,6 +127,25 @@ TEST(Portfolio, RefusesABadTimeBudget) {
   PortfolioOptions options;
   options.min_budget_s = -1.0;
   EXPECT_THROW(options.validate(), std::invalid_argument);
+  for (double cap : {-1.0, std::nan(""), double(INFINITY)}) {
+    PortfolioOptions capped;
+    capped.max_seconds = cap;
+    EXPECT_THROW(capped.validate(), std::invalid_argument) << cap;
+  }
+}
+
+TEST(Portfolio, NoStrategyRunsPastTheCapInSeconds) {
+  // No ratio limit, but a cap Algorithm 2 alone already passes: the others
+  // are not started, and the plan is Algorithm 2's.
+  const PlanRequest request = volcano_request({2, 3, 0.038, 4});
+  PortfolioOptions options;
+  options.max_time_ratio = 0.0;
+  options.max_seconds = 1e-9;
+  const PlanResult best = Portfolio(options).plan(request);
+  EXPECT_EQ(best.note.rfind("chose algorithm2;", 0), 0u) << best.note;
+  std::size_t skipped = 0;
+  for (std::size_t at = 0; (at = best.note.find("not started", at)) != std::string::npos; ++at) ++skipped;
+  EXPECT_EQ(skipped, Portfolio::strategies().size() - 1) << best.note;
 }
 
 TEST(RefusedActions, ADeadEndIsRecordedAndThePlanFinishes) {

@@ -24,27 +24,36 @@ struct StrategyOutcome {
   double score = -INFINITY;
   double seconds = 0.0;
   bool stopped_at_budget = false;  // result is the plan it had then
+  bool not_started = false;        // the budget was spent before its turn
   std::string error;
 };
 
 using Clock = std::chrono::steady_clock;
 
 // The time the strategies after Algorithm 2 may take: none until Algorithm 2
-// has finished, then max_time_ratio times its time from the start.
+// has finished, then max_time_ratio times its time from the start, but never
+// past max_seconds.
 class StrategyBudget {
  public:
   StrategyBudget(const PortfolioOptions& options, Clock::time_point start) : options_(options), start_(start) {}
   void algorithm2_took(double seconds) {
-    if (options_.max_time_ratio <= 0.0) return;
     algorithm2_s_ = seconds;
-    limit_s_.store(std::max(options_.max_time_ratio * seconds, options_.min_budget_s));
+    double limit = INFINITY;
+    if (options_.max_time_ratio > 0.0) limit = std::max(options_.max_time_ratio * seconds, options_.min_budget_s);
+    if (options_.max_seconds > 0.0) limit = std::min(limit, options_.max_seconds);
+    limit_s_.store(limit);
   }
   bool spent() const { return elapsed_s() > limit_s_.load(); }
   double elapsed_s() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
   std::string describe() const {
     char text[120];
-    std::snprintf(text, sizeof text, "stopped at the time budget, %.3g s (%.3g x algorithm2's %.3g s)", limit_s_.load(),
-                  options_.max_time_ratio, algorithm2_s_);
+    const double limit = limit_s_.load();
+    if (options_.max_seconds > 0.0 && limit == options_.max_seconds)
+      std::snprintf(text, sizeof text, "stopped at the time budget, the cap of %.3g s (algorithm2 took %.3g s)", limit,
+                    algorithm2_s_);
+    else
+      std::snprintf(text, sizeof text, "stopped at the time budget, %.3g s (%.3g x algorithm2's %.3g s)", limit,
+                    options_.max_time_ratio, algorithm2_s_);
     return text;
   }
 
@@ -63,6 +72,8 @@ void PortfolioOptions::validate() const {
     throw std::invalid_argument("PortfolioOptions.max_time_ratio must be a finite number >= 0 (0: no limit)");
   if (!(min_budget_s >= 0.0) || !std::isfinite(min_budget_s))
     throw std::invalid_argument("PortfolioOptions.min_budget_s must be a finite number >= 0");
+  if (!(max_seconds >= 0.0) || !std::isfinite(max_seconds))
+    throw std::invalid_argument("PortfolioOptions.max_seconds must be a finite number >= 0 (0: no cap)");
 }
 
 Portfolio::Portfolio(PortfolioOptions options) : options_(options) { options_.validate(); }
@@ -116,6 +127,12 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
         report(k, std::clamp(fraction, 0.0, 1.0), what);
       };
     StrategyOutcome& out = outcomes[k];
+    if (k != 0 && budget.spent()) {
+      out.not_started = true;
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (callbacks.progress) report(k, 1.0, "not started");
+      return;
+    }
     const double started_s = budget.elapsed_s();
     try {
       out.result = list[k].second->plan(request, own);
@@ -162,9 +179,12 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
     if (outcomes[k].result)
       std::snprintf(line, sizeof line, " %s %.4f in %.3g s%s", list[k].first.c_str(), outcomes[k].score,
                     outcomes[k].seconds, outcomes[k].stopped_at_budget ? " (its plan so far, stopped at the time budget)" : "");
+    else if (outcomes[k].not_started)
+      std::snprintf(line, sizeof line, " %s not started (the time budget was spent)", list[k].first.c_str());
     else
       std::snprintf(line, sizeof line, " %s failed (%.100s)", list[k].first.c_str(), outcomes[k].error.c_str());
-    note += (k ? ";" : "") + std::string(line);
+    if (k) note += ';';
+    note += line;
     if (outcomes[k].result && (best == n || outcomes[k].score > outcomes[best].score)) best = k;
   }
   if (best == n) throw std::runtime_error("portfolio: no strategy finished a plan (" + note + ")");
