@@ -6,7 +6,6 @@
 #include <cmath>
 #include <stdexcept>
 #include <utility>
-#include <vector>
 
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
@@ -37,16 +36,18 @@ Correlation correlate_named(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, 
     throw std::invalid_argument("correlation needs inputs of one shape, got " + name_a + " " + shape_of(a) +
                                 " and " + name_b + " " + shape_of(b));
 
-  // The samples finite in both, (n) each.
-  std::vector<double> va, vb;
-  va.reserve(a.size());
-  vb.reserve(b.size());
-  for (Eigen::Index k = 0; k < a.size(); ++k)
-    if (std::isfinite(a(k)) && std::isfinite(b(k))) {
-      va.push_back(a(k));
-      vb.push_back(b(k));
-    }
-  const int n = static_cast<int>(va.size());
+  // Pass 1 over the samples finite in both: their count, sums and ranges.
+  const auto both_finite = [&](Eigen::Index k) { return std::isfinite(a(k)) && std::isfinite(b(k)); };
+  int n = 0;
+  double sum_a = 0.0, sum_b = 0.0;
+  double a_min = INFINITY, a_max = -INFINITY, b_min = INFINITY, b_max = -INFINITY;
+  for (Eigen::Index k = 0; k < a.size(); ++k) {
+    if (!both_finite(k)) continue;
+    ++n;
+    sum_a += a(k), sum_b += b(k);
+    a_min = std::min(a_min, a(k)), a_max = std::max(a_max, a(k));
+    b_min = std::min(b_min, b(k)), b_max = std::max(b_max, b(k));
+  }
   if (n < 2)
     return undefined("only " + std::to_string(n) + " sample(s) are valid (finite) in both " + name_a + " and " +
                          name_b + ", and correlation needs at least 2",
@@ -54,27 +55,20 @@ Correlation correlate_named(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, 
 
   // Flatness is tested exactly (min == max): a computed variance of a
   // constant can come out as rounding noise instead of zero.
-  const auto [a_min, a_max] = std::minmax_element(va.begin(), va.end());
-  if (*a_min == *a_max) return undefined(flat_reason(name_a, quantity, n), n);
-  const auto [b_min, b_max] = std::minmax_element(vb.begin(), vb.end());
-  if (*b_min == *b_max) return undefined(flat_reason(name_b, quantity, n), n);
+  if (a_min == a_max) return undefined(flat_reason(name_a, quantity, n), n);
+  if (b_min == b_max) return undefined(flat_reason(name_b, quantity, n), n);
 
-  // Deviations from the means, scaled by their ranges so the sums of
-  // squares cannot overflow or underflow (r does not change).
-  auto deviations = [](std::vector<double>& v, double range) {
-    double mean = 0.0;
-    for (double x : v) mean += x;
-    mean /= static_cast<double>(v.size());
-    for (double& x : v) x = (x - mean) / range;
-  };
-  deviations(va, *a_max - *a_min);
-  deviations(vb, *b_max - *b_min);
-
+  // Pass 2: deviations from the means, scaled by their ranges so the sums
+  // of squares cannot overflow or underflow (r does not change).
+  const double mean_a = sum_a / double(n), mean_b = sum_b / double(n);
+  const double range_a = a_max - a_min, range_b = b_max - b_min;
   double sab = 0.0, saa = 0.0, sbb = 0.0;
-  for (int k = 0; k < n; ++k) {
-    sab += va[k] * vb[k];
-    saa += va[k] * va[k];
-    sbb += vb[k] * vb[k];
+  for (Eigen::Index k = 0; k < a.size(); ++k) {
+    if (!both_finite(k)) continue;
+    const double da = (a(k) - mean_a) / range_a, db = (b(k) - mean_b) / range_b;
+    sab += da * db;
+    saa += da * da;
+    sbb += db * db;
   }
   Correlation c;
   c.value = std::clamp(sab / std::sqrt(saa * sbb), -1.0, 1.0);

@@ -1,8 +1,10 @@
 // Planning speed: Algorithm 2 for a real DEM (Maunga Whau) resampled to the
-// array, a GeoTIFF DEM, and the sweep of one goal over array sizes.
+// array, a GeoTIFF DEM, the sweep of one goal over array sizes, and scoring
+// a plan against its goal image (the portfolio scores every strategy's).
 // Run: ./build/hj_bench --benchmark_filter="^BM_(Plan|Sweep)"
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <exception>
 
 #include "plan/planner.h"
@@ -32,6 +34,22 @@ void BM_PlanVolcanoDem(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PlanVolcanoDem)->Args({3, 4})->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// plan_score (Eq. 12 against the goal image) of a predicted surface: the
+// Jacksboro DEM (the largest shared image) and a dome, at 1 x 2 and 9 x 12.
+void BM_PlanScore(benchmark::State& state) {
+  const hj::ArrayGeometry g{static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 0.038, 4};
+  const hj::HeightMap goal = hj::import_goal(HJ_SHARED_DIR "/data/dem/jacksboro_fault_tn.csv");
+  const hj::Mesh mesh(g);
+  const hj::PlanRequest request{g, hj::SurfaceParameters::paper_defaults(g), hj::resample_to_mesh(goal, mesh, 30.0),
+                                {}, goal.z};
+  hj::DeviceState dome;
+  dome.x = mesh.rest_positions();
+  for (int i = 0; i < dome.x.cols(); ++i) dome.x(2, i) = 0.01 * std::sin(3.0 * dome.x(0, i)) * std::cos(5.0 * dome.x(1, i));
+  for (auto _ : state) benchmark::DoNotOptimize(hj::plan_score(request, mesh, dome));
+  state.counters["pixels"] = double(goal.z.size());
+}
+BENCHMARK(BM_PlanScore)->Args({1, 2})->Args({9, 12})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PlanVolcanoDem)->Name("Slow/BM_PlanVolcanoDem")->Args({6, 8})->Args({9, 12})->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // The from-above planner (src/plan/from_above.h) on the same DEM.
