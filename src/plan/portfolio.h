@@ -22,13 +22,13 @@ struct PortfolioOptions {
   // running then is stopped, and the plan it had so far competes with the
   // finished ones. 0: no limit. The aim is at most 5 x Algorithm 2 run on
   // its own, and the ratio leaves room for two things: the same plan's time
-  // varies by up to 1.3 x from one run to the next, and at 1 x 2 (plans of
-  // a few ms) stopping and scoring the strategies adds 0.5-1 x its time.
+  // varies by up to 1.6 x from one run to the next, and at 1 x 2 (plans of
+  // a few ms) stopping and scoring the strategies adds about half its time.
   double max_time_ratio = 3.5;
   double min_budget_s = 0.0;
-  // And never past this many seconds from the start, whatever Algorithm 2
-  // took, so a 9 x 12 plan answers a map viewer within 10 s (Algorithm 2
-  // takes 2-5 s there); a strategy not started by then is skipped. 0: no cap.
+  // And never past this many seconds from the start, so a 9 x 12 plan
+  // answers a map viewer within 10 s (Algorithm 2 itself still runs to its
+  // end); a strategy whose turn comes later is not started. 0: no cap.
   double max_seconds = 9.0;
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
