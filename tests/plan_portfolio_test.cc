@@ -17,6 +17,12 @@ namespace {
 
 Eigen::MatrixXd heights_mm(const Mesh& mesh, const DeviceState& state) { return point_heights(mesh, state.x) * 1000.0; }
 
+std::size_t occurrences(const std::string& text, const std::string& what) {
+  std::size_t count = 0;
+  for (std::size_t at = 0; (at = text.find(what, at)) != std::string::npos; at += what.size()) ++count;
+  return count;
+}
+
 // The plan's steps replayed from rest, as `hapticjam simulate` does: the
 // largest distance of a point from the plan's predicted surface, m.
 double replay_gap_m(const PlanRequest& request, const PlanResult& plan) {
@@ -83,9 +89,7 @@ TEST(Portfolio, StopsTheOtherStrategiesAtItsTimeBudget) {
   const PlanResult best = Portfolio(options).plan(request);
   const PlanResult paper = make_planner("algorithm2")->plan(request);
   EXPECT_EQ(best.note.rfind("chose algorithm2;", 0), 0u) << best.note;
-  std::size_t skipped = 0;
-  for (std::size_t at = 0; (at = best.note.find("not started", at)) != std::string::npos; ++at) ++skipped;
-  EXPECT_EQ(skipped, Portfolio::strategies().size() - 1) << best.note;
+  EXPECT_EQ(occurrences(best.note, "not started"), Portfolio::strategies().size() - 1) << best.note;
   EXPECT_EQ(best.steps.size(), paper.steps.size());
   EXPECT_LT((best.final_state.x - paper.final_state.x).cwiseAbs().maxCoeff(), 1e-9);
 }
@@ -143,9 +147,7 @@ TEST(Portfolio, NoStrategyRunsPastTheCapInSeconds) {
   options.max_seconds = 1e-9;
   const PlanResult best = Portfolio(options).plan(request);
   EXPECT_EQ(best.note.rfind("chose algorithm2;", 0), 0u) << best.note;
-  std::size_t skipped = 0;
-  for (std::size_t at = 0; (at = best.note.find("not started", at)) != std::string::npos; ++at) ++skipped;
-  EXPECT_EQ(skipped, Portfolio::strategies().size() - 1) << best.note;
+  EXPECT_EQ(occurrences(best.note, "not started"), Portfolio::strategies().size() - 1) << best.note;
 }
 
 TEST(RefusedActions, ADeadEndIsRecordedAndThePlanFinishes) {

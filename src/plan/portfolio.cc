@@ -112,6 +112,12 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
   const auto user_cancelled = [&] { return callbacks.cancelled && callbacks.cancelled(); };
 
   const auto run = [&](std::size_t k) {
+    if (k != 0 && budget.spent()) {
+      outcomes[k].not_started = true;
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (callbacks.progress) report(k, 1.0, "not started");
+      return;
+    }
     PlanCallbacks own;
     // Strategy 0 is Algorithm 2, which always runs to its end.
     own.cancelled = [&, k] { return user_cancelled() || (k != 0 && budget.spent()); };
@@ -127,12 +133,6 @@ PlanResult Portfolio::plan(const PlanRequest& request, const PlanCallbacks& call
         report(k, std::clamp(fraction, 0.0, 1.0), what);
       };
     StrategyOutcome& out = outcomes[k];
-    if (k != 0 && budget.spent()) {
-      out.not_started = true;
-      const std::lock_guard<std::mutex> lock(mutex);
-      if (callbacks.progress) report(k, 1.0, "not started");
-      return;
-    }
     const double started_s = budget.elapsed_s();
     try {
       out.result = list[k].second->plan(request, own);
