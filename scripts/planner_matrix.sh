@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Every registered planner on the 11 shared goals (5 DEM files, 6 mesh
-# files) at the given sizes: size by size, one `sweep` per planner (so the
-# planners' times are taken minutes apart at most, not a whole sweep apart on
-# a machine whose speed drifts), merged into OUT_DIR/PLANNER/sweep.csv; then
-# per planner how many plans finished (status ok), the slowest, and the mean
-# correlation; and the portfolio against Algorithm 2 plan by plan
-# (scripts/portfolio_gain.py).
+# files) at the given sizes: goal by goal, one `sweep` per planner (so the
+# planners' times of a plan are taken a minute or two apart, not a whole
+# sweep apart on a machine whose speed drifts), merged into
+# OUT_DIR/PLANNER/sweep.csv; then per planner how many plans finished
+# (status ok), the slowest, and the mean correlation; and the portfolio
+# against Algorithm 2 plan by plan (scripts/portfolio_gain.py).
 # Usage: scripts/planner_matrix.sh [OUT_DIR] (default /tmp/planner-matrix);
 # SIZES (default 9x12; "paper" for the 16 Table 1 sizes, or a list such as
 # 2x3,9x12), PLANNERS (default: every registered one), HJ_BIN (default
@@ -18,21 +18,17 @@ shared=$root/../shared/data
 out=${1:-/tmp/planner-matrix}
 goals=("$shared"/dem/*.csv "$shared"/dem/*.tif "$shared"/mesh/*.stl "$shared"/mesh/*.obj)
 planners=${PLANNERS:-algorithm2 algorithm2-levelled algorithm2-refined from-above portfolio}
-sizes=${SIZES:-9x12}
-# The 16 sizes of Table 1 (src/plan/sweep.cc, paper_array_sizes).
-[[ $sizes == paper ]] && sizes=1x2,2x3,3x4,3x5,4x5,4x6,5x6,5x7,5x8,6x7,6x8,6x9,7x9,7x10,8x11,9x12
 mkdir -p "$out"
 for planner in $planners; do rm -f "$out/$planner.log"; done
-for size in ${sizes//,/ }; do
+for k in "${!goals[@]}"; do  # by index: the Luxembourg CSV and TIFF share a name
   for planner in $planners; do
-    "$bin" sweep "${goals[@]}" --sizes "$size" --planner "$planner" --jobs "${JOBS:-1}" --budget-s 900 \
-      --out "$out/$planner/$size" >>"$out/$planner.log" 2>&1
+    "$bin" sweep "${goals[$k]}" --sizes "${SIZES:-9x12}" --planner "$planner" --jobs "${JOBS:-1}" --budget-s 900 \
+      --out "$out/$planner/goal$k" >>"$out/$planner.log" 2>&1
   done
 done
-for planner in $planners; do  # one sweep.csv per planner, the sizes in order
-  first=1
-  for size in ${sizes//,/ }; do
-    if ((first)); then cat "$out/$planner/$size/sweep.csv"; first=0; else tail -n +2 "$out/$planner/$size/sweep.csv"; fi
+for planner in $planners; do  # one sweep.csv per planner, the goals in order
+  for k in "${!goals[@]}"; do
+    if ((k == 0)); then cat "$out/$planner/goal$k/sweep.csv"; else tail -n +2 "$out/$planner/goal$k/sweep.csv"; fi
   done >"$out/$planner/sweep.csv"
 done
 python3 - "$out" $planners <<'PY'
