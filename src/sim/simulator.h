@@ -127,6 +127,16 @@ class Simulator {
   // at a dead end (sim/dead_end_watch.h), which sets flow_dead_end_.
   ImplicitFlowOptions flow_options();
   const SettleReport& apply_from(const Action& action, const Eigen::Matrix3Xd* start);
+  // A pressure change's settle from the simulator's own prediction (the
+  // coarse mesh's dome, or the mirrored sag), without fallbacks: the fast
+  // control from the prediction, then from the state as it is (`cold`),
+  // then the careful control from the prediction. True if one settled;
+  // last_ counts the steps of all it tried.
+  bool settle_from_prediction(const Eigen::Matrix3Xd& cold, const Eigen::Matrix3Xd& prediction, bool from_coarse);
+  // One settle without fallbacks from `from` (its free points), with the
+  // static solver's controls limited as `controls` says.
+  enum class Controls { kBoth, kFastOnly, kCarefulOnly };
+  bool settle_trial_from(const Eigen::Matrix3Xd& from, Controls controls, bool close);
 
   // The steps the current action's settle has polled (max_settle_steps);
   // shared with the solvers' interrupted callbacks, so a moved simulator keeps it.
@@ -153,6 +163,8 @@ class Simulator {
   bool keeps_equilibrium_ = false;
   // Set by apply_from while a settle starts from the coarse mesh's dome.
   bool close_start_ = false;
+  // The static solver's controls in the settle under way (settle_trial_from).
+  Controls controls_ = Controls::kBoth;
   // With refuse_folded: the flow from the state before the action reached a
   // dead end, so the settle ends there without the slower controls;
   // flow_dead_end_ says why ("" while the last flow was not abandoned).
