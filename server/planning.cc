@@ -14,6 +14,7 @@ PlanningOutput run_planning(const PlanningInput& input, const PlanCallbacks& cal
   PlanRequest request{input.array.geometry, input.array.params,
                       goal_to_mesh(input.goal, mesh, input.heights, input.max_height_mm),
                       input.array.simulator, input.goal.z};
+  if (input.heights == GoalHeights::kAbsolute) request.scoring = PlanScoring::kHeightError;
   out.result = planner->plan(request, callbacks);
   out.goal_mm = std::move(request.goal_mm);
   out.predicted_mm = point_heights(mesh, out.result.final_state.x) * 1000.0;

@@ -145,7 +145,8 @@ class RenderRun {
 
   PlanResult plan(int iteration) {
     const PlanningModel model = planning_model();
-    PlanRequest request{setup_.array.geometry, model.surface, targets_, model.simulator, {}};
+    // The loop measures millimetres: a planner choosing among surfaces chooses by them.
+    PlanRequest request{setup_.array.geometry, model.surface, targets_, model.simulator, {}, PlanScoring::kHeightError};
     PlanCallbacks callbacks;
     callbacks.cancelled = hooks_.cancelled;
     callbacks.progress = [&](double fraction, const std::string& what) {

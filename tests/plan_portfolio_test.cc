@@ -78,6 +78,35 @@ TEST(Portfolio, IsNeverBelowAlgorithm2AndSaysWhatItChose) {
   EXPECT_LT(replay_gap_m(request, best), 1e-5);
 }
 
+TEST(PlanScore, HeightErrorSeesTheScaleThatCorrelationDoesNot) {
+  const ArrayGeometry g{3, 4, 0.038, 4};
+  PlanRequest request{g, SurfaceParameters::paper_defaults(g), device_made_goal(g), {}, {}};
+  const Eigen::MatrixXd twice = 2.0 * request.goal_mm;
+  EXPECT_NEAR(mesh_point_score(request, twice), 1.0, 1e-12);
+  request.scoring = PlanScoring::kHeightError;
+  EXPECT_EQ(mesh_point_score(request, request.goal_mm), 0.0);
+  const double rms_goal = std::sqrt(request.goal_mm.array().square().mean());
+  EXPECT_NEAR(mesh_point_score(request, twice), -rms_goal, 1e-9);
+  EXPECT_GT(mesh_point_score(request, request.goal_mm.array() + 1.0), mesh_point_score(request, twice));
+}
+
+// A goal in absolute millimetres: the portfolio keeps the plan whose
+// heights are closest, and is never farther than Algorithm 2's.
+TEST(Portfolio, ChoosesByHeightsForAGoalInMillimetres) {
+  const ArrayGeometry g{3, 4, 0.038, 4};
+  const Mesh mesh(g);
+  PlanRequest request{g, SurfaceParameters::paper_defaults(g), device_made_goal(g), {}, {},
+                      PlanScoring::kHeightError};
+  PortfolioOptions unlimited;
+  unlimited.max_time_ratio = 0.0;
+  const PlanResult best = Portfolio(unlimited).plan(request);
+  const PlanResult paper = make_planner("algorithm2")->plan(request);
+  const double best_score = plan_score(request, mesh, best.final_state);
+  EXPECT_GE(best_score, plan_score(request, mesh, paper.final_state)) << best.note;
+  EXPECT_LT(-best_score, 0.1 * (request.goal_mm.maxCoeff() - request.goal_mm.minCoeff())) << best.note;
+  EXPECT_LT(replay_gap_m(request, best), 1e-5);
+}
+
 TEST(Portfolio, StopsTheOtherStrategiesAtItsTimeBudget) {
   // One thread runs Algorithm 2 first; a budget of a tiny fraction of its
   // time is spent before any other strategy's turn, so none is started.

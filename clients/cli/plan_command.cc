@@ -159,6 +159,7 @@ int plan(const PlanArgs& args) {
   PlanRequest request{geometry, SurfaceParameters::paper_defaults(geometry),
                       goal_to_mesh(goal, mesh, args.heights, args.max_height_mm), {}, goal.z};
   const bool absolute = args.heights == GoalHeights::kAbsolute;
+  if (absolute) request.scoring = PlanScoring::kHeightError;
   const double relief_mm = absolute ? request.goal_mm.maxCoeff() - request.goal_mm.minCoeff()
                                     : relief_or_default_mm(args.max_height_mm, geometry);
   const auto planner = make_planner(args.planner);

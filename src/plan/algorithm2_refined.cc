@@ -91,7 +91,7 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
   // between pins relax from the bulge that lifting the highest nodes needed.
   // Scan down towards the levelling pressure and end at the best one.
   const auto score = [&] {
-    return correlate(request.goal_mm, point_heights(mesh, sim.state().x) * 1000.0).value.value_or(-INFINITY);
+    return mesh_point_score(request, point_heights(mesh, sim.state().x) * 1000.0);
   };
   double best_pressure = sim.state().pressure_pa, best_r = score();
   for (double f : kEndPressureFactors) {
@@ -156,8 +156,7 @@ PlanResult Algorithm2Refined::plan(const PlanRequest& request, const PlanCallbac
       last_error = e.what();  // no equilibrium on this path: the other variants may find one
       continue;
     }
-    const Correlation c = correlate(request.goal_mm, point_heights(mesh, candidate.final_state.x) * 1000.0);
-    const double r = c.value.value_or(-INFINITY);
+    const double r = mesh_point_score(request, point_heights(mesh, candidate.final_state.x) * 1000.0);
     if (!best || r > best_r) best_r = r, best = std::move(candidate);
   }
   if (!best) throw std::runtime_error("algorithm2-refined: no variant reached equilibrium: " + last_error);

@@ -1,6 +1,7 @@
 // A planner that searches over variants of the paper's Algorithm 2 and keeps
-// the one whose surface correlates best (Eq. 12) with the goal at the mesh
-// points. Each variant is a complete sweep from rest, ended by a scan of
+// the one whose surface scores best against the goal at the mesh points
+// (mesh_point_score: the correlation, or the height error for a goal in
+// absolute millimetres). Each variant is a complete sweep from rest, ended by a scan of
 // lower end pressures (with the pins and jams set, the cells between pins
 // relax from the bulge that lifting the highest nodes needed; the best end
 // pressure is the last step), with these knobs:

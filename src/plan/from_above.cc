@@ -111,10 +111,10 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
 
   // End pressure: with the pins and jams set, cells between pins sag below
   // levelling and bulge above it. From the pressure reached, step through
-  // the end pressures downwards while the correlation improves, else
-  // upwards while it improves (a hill climb), and end at the best.
+  // the end pressures downwards while the score improves, else upwards
+  // while it improves (a hill climb), and end at the best.
   const auto score = [&] {
-    return correlate(request.goal_mm, point_heights(mesh, sim.state().x) * 1000.0).value.value_or(-INFINITY);
+    return mesh_point_score(request, point_heights(mesh, sim.state().x) * 1000.0);
   };
   std::vector<double> below, above;
   for (double f : kEndPressureFactors) {

@@ -7,8 +7,8 @@
 // Above levelling the dome's height changes smoothly with the pressure,
 // whereas rising from the sag the slack net jumps to a tall dome just past
 // levelling (algorithm2.cc pins the first nodes far above their goals). The
-// run ends with a hill climb over a few end pressures on the correlation at
-// the mesh points. See from_above.cc.
+// run ends with a hill climb over a few end pressures on the score at the
+// mesh points (mesh_point_score). See from_above.cc.
 #pragma once
 
 #include "plan/planner.h"

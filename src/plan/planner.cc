@@ -162,11 +162,19 @@ Eigen::Matrix3Xd goal_positions(const Mesh& mesh, const Eigen::MatrixXd& goal_mm
 
 double plan_score(const PlanRequest& request, const Mesh& mesh, const DeviceState& state) {
   const Eigen::MatrixXd heights_mm = point_heights(mesh, state.x) * 1000.0;
+  if (request.scoring == PlanScoring::kHeightError || request.goal_image.size() == 0)
+    return mesh_point_score(request, heights_mm);
   // Mesh row i runs along +y; the image's row 0 is its top.
-  const Correlation c = request.goal_image.size() > 0
-                            ? correlate_with_goal(request.goal_image, heights_mm.colwise().reverse())
-                            : correlate(request.goal_mm, heights_mm);
-  return c.value.value_or(-INFINITY);
+  return correlate_with_goal(request.goal_image, heights_mm.colwise().reverse()).value.value_or(-INFINITY);
+}
+
+double mesh_point_score(const PlanRequest& request, const Eigen::MatrixXd& heights_mm) {
+  if (request.scoring == PlanScoring::kCorrelation)
+    return correlate(request.goal_mm, heights_mm).value.value_or(-INFINITY);
+  const Eigen::ArrayXXd error = (heights_mm - request.goal_mm).array();
+  const Eigen::Index finite = error.isFinite().count();
+  if (finite == 0) return -INFINITY;
+  return -std::sqrt(error.isFinite().select(error.square(), 0.0).sum() / static_cast<double>(finite));
 }
 
 double plan_max_pressure(double option_pa, const SurfaceParameters& params) {

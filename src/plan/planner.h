@@ -17,6 +17,12 @@
 
 namespace hj {
 
+// How a planner judges a surface against the goal, where it chooses among
+// candidates: the paper's correlation (Eq. 12), blind to scale, or, for a
+// goal whose millimetres are meant (absolute heights, the render loop's
+// targets), the closeness of the heights at the mesh points.
+enum class PlanScoring { kCorrelation, kHeightError };
+
 struct PlanRequest {
   ArrayGeometry geometry;
   SurfaceParameters params;
@@ -26,6 +32,7 @@ struct PlanRequest {
   // The goal image the plan is scored against (Eq. 12; row 0 at the top),
   // if the caller has it; empty: plans are compared at the mesh points.
   Eigen::MatrixXd goal_image;
+  PlanScoring scoring = PlanScoring::kCorrelation;
 };
 
 struct PlanCallbacks {
@@ -132,10 +139,15 @@ bool is_free_net(const Mesh& mesh, const DeviceState& state);
 // The goal as a surface on the mesh: rest positions with z = scale * goal_mm / 1000 (3 x N, m).
 Eigen::Matrix3Xd goal_positions(const Mesh& mesh, const Eigen::MatrixXd& goal_mm, double scale = 1.0);
 
-// How well a state matches the request's goal: Eq. 12 against goal_image
-// when given, else the correlation with goal_mm at the mesh points; -inf
-// where undefined. Planners that choose among candidates maximise it.
+// How well a state matches the request's goal, higher is better: with
+// kCorrelation, Eq. 12 against goal_image when given, else the correlation
+// with goal_mm at the mesh points; with kHeightError, minus the RMSE (mm)
+// against goal_mm at the mesh points. -inf where undefined. The portfolio
+// chooses its strategy by it.
 double plan_score(const PlanRequest& request, const Mesh& mesh, const DeviceState& state);
+// The same at the mesh points only (heights_mm as point_heights, in mm):
+// what a planner's own choices (an end pressure, a variant) maximise.
+double mesh_point_score(const PlanRequest& request, const Eigen::MatrixXd& heights_mm);
 
 // A planner's pressure ceiling: its option (0: none) capped by the device's.
 double plan_max_pressure(double option_pa, const SurfaceParameters& params);
