@@ -346,13 +346,10 @@ void search_the_rest(Selection& s, std::vector<CandidateFit>& refitted, const st
   }
 }
 
-// Moves the refitted candidates into `fits`, the best significant one (the
-// lowest held-out RMSE) at the front.
+// Moves the refitted candidates into `fits`, the best significant one
+// (ranks_before) at the front.
 void add_best_first(std::vector<CandidateFit>& refitted, std::vector<CandidateFit>& fits) {
-  auto first = std::min_element(refitted.begin(), refitted.end(), [](const CandidateFit& a, const CandidateFit& b) {
-    if (a.significant != b.significant) return a.significant;
-    return a.heldout_rmse_mm < b.heldout_rmse_mm;
-  });
+  auto first = std::min_element(refitted.begin(), refitted.end(), ranks_before);
   const bool lead = first != refitted.end() && first->significant;
   if (lead) std::rotate(refitted.begin(), first, first + 1);
   fits.insert(lead ? fits.begin() : fits.end(), std::make_move_iterator(refitted.begin()),

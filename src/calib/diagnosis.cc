@@ -78,6 +78,12 @@ bool converge(const Dataset& dataset, const std::vector<FitParameter>& parameter
 
 }  // namespace
 
+bool ranks_before(const CandidateFit& a, const CandidateFit& b) {
+  if (a.significant != b.significant) return a.significant;
+  if (a.significant) return a.delta_bic < b.delta_bic;
+  return a.heldout_rmse_mm < b.heldout_rmse_mm;
+}
+
 void cross_validate_candidate(const Dataset& dataset, const std::vector<FitParameter>& parameters,
                               const ReplayOptions& replay, CandidateFit& c) {
   CrossValidation cv = cross_validate(dataset, parameters, c.fit, replay);
@@ -88,13 +94,7 @@ void cross_validate_candidate(const Dataset& dataset, const std::vector<FitParam
 
 namespace {
 
-// Best first: the significant ones, then by held-out RMSE.
-void rank(std::vector<CandidateFit>& fits) {
-  std::stable_sort(fits.begin(), fits.end(), [](const CandidateFit& a, const CandidateFit& b) {
-    if (a.significant != b.significant) return a.significant;
-    return a.heldout_rmse_mm < b.heldout_rmse_mm;
-  });
-}
+void rank(std::vector<CandidateFit>& fits) { std::stable_sort(fits.begin(), fits.end(), ranks_before); }
 
 // Replaces `current` (and its held-out RMSE, the ladder's last step, and
 // in round 0 the baseline) by the current model refitted from `c`'s
@@ -395,7 +395,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
   out.noise_floor_mm = noise_floor_mm(dataset);
   fit_baseline(dataset, start, options, progress, out);
   // Greedy forward selection: each round adds the significant candidate
-  // with the lowest held-out error to the current model.
+  // with the lowest delta BIC to the current model (ranks_before).
   Selection s{dataset, options, progress, out, {}, out.baseline.joint, out.baseline_heldout_rmse_mm};
   std::vector<std::string> remaining = candidate_effects(options);
   for (int round = 0; round < options.max_effects && !remaining.empty(); ++round) {
