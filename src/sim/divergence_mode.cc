@@ -5,6 +5,8 @@
 #include <cmath>
 #include <optional>
 
+#include "sim/amd_ordering.h"
+
 namespace hj {
 
 namespace {
@@ -54,14 +56,12 @@ bool DivergenceSearch::sym_positive_definite() {
   Factors& f = *factors_;
   if (!f.sym_positive_definite) {
     const Eigen::SparseMatrix<double> sym = 0.5 * (stiffness_ + Eigen::SparseMatrix<double>(stiffness_.transpose()));
-    // Natural order: K is banded in the mesh's order already, and in the
-    // server's build Eigen's AMD ordering read past its own buffer (ASan).
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(sym);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, SuiteSparseAmdOrdering> ldlt(sym);
     f.sym_positive_definite = false;
     if (ldlt.info() == Eigen::Success) {
       const Eigen::VectorXd d = ldlt.vectorD();
       // Without pivoting, the signs of D are the signs of the eigenvalues
-      // (Sylvester's law of inertia).
+      // (Sylvester's law of inertia), in any symmetric order.
       f.sym_positive_definite = d.minCoeff() > 1e-12 * d.cwiseAbs().maxCoeff();
     }
   }
