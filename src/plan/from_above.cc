@@ -1,7 +1,9 @@
 #include "plan/from_above.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "metrics/correlation.h"
@@ -14,6 +16,25 @@ namespace {
 // End pressures tried after the descent, as multiples of the levelling
 // pressure, in rising order.
 constexpr double kEndPressureFactors[] = {0.0, 0.5, 0.8, 0.9, 1.02, 1.1, 1.25, 1.5, 2.0};
+
+// The largest pressure decrement that takes no free node more than
+// tolerance_m below its goal, each node's height extrapolated linearly from
+// its fall over the last step (`z_before`, the heights dp_last higher);
+// infinity where no free node is falling. Jams and pins since change the
+// slopes, so it is a guess: a step that still goes too far is taken back.
+double predicted_safe_decrement(const Mesh& mesh, const DeviceState& state, const Eigen::VectorXd& z_before,
+                                double dp_last, const Eigen::Matrix3Xd& goal_x, double tolerance_m) {
+  double safe = std::numeric_limits<double>::infinity();
+  for (int a = 1; a < mesh.rows(); ++a)
+    for (int b = 1; b < mesh.cols(); ++b) {
+      if (state.pinned(mesh, a, b)) continue;
+      const int point = mesh.node_point(a, b);
+      const double fall_per_pa = (z_before(point) - state.x(2, point)) / dp_last;
+      if (fall_per_pa > 0.0)
+        safe = std::min(safe, (state.x(2, point) - goal_x(2, point) + tolerance_m) / fall_per_pa);
+    }
+  return safe;
+}
 
 }  // namespace
 
@@ -84,21 +105,38 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
   // Down: pin nodes and jam cells as they come down to their goals. A step
   // with no equilibrium, or one that takes a free node too far below its
   // goal, is halved (down to min_step_pa; a refused one that small ends the descent).
+  // A step too far is taken back by rewinding the simulator, not by raising
+  // the pressure again: the plan (and the device) never makes it, and the
+  // settle back up is not paid for.
   double pressure = sim.state().pressure_pa;
   const double top = pressure;
   double step = options_.decrement_pa;
+  Eigen::VectorXd z_before;  // the heights before the last step kept, and its size
+  double last_step = 0.0;
   while (pressure > p_floor) {
-    const double next = std::max(pressure - step, p_floor);
+    // Within the step as halved, short of where the nodes are predicted to
+    // go too far (with a margin: the fall is not linear in the pressure).
+    const double trial =
+        last_step > 0.0
+            ? std::clamp(0.8 * predicted_safe_decrement(mesh, sim.state(), z_before, last_step, goal_x, tolerance_m),
+                         std::min(options_.min_step_pa, step), step)
+            : step;
+    const double next = std::max(pressure - trial, p_floor);
+    const Simulator::Checkpoint before = sim.checkpoint();
+    const std::size_t steps_before_trial = result.steps.size();
     if (!apply(next)) {
-      if (step <= options_.min_step_pa) break;
-      step /= 2.0;
+      if (trial <= options_.min_step_pa) break;
+      step = trial / 2.0;
       continue;
     }
-    if (step > options_.min_step_pa && free_node_height_error([&](double dz) { return dz < -tolerance_m; }) &&
-        apply(pressure)) {  // back off, halve the step
-      step /= 2.0;
+    if (trial > options_.min_step_pa && free_node_height_error([&](double dz) { return dz < -tolerance_m; })) {
+      sim.rewind(before);
+      result.steps.resize(steps_before_trial);
+      step = trial / 2.0;
       continue;
     }
+    last_step = pressure - next;
+    z_before = before.state.x.row(2).transpose();
     pressure = next;
     const std::size_t steps_before = result.steps.size();
     const bool nodes_done = pin_reached_nodes(sim, goal_x, Reach::kFromAbove, result, callbacks);

@@ -205,6 +205,15 @@ void Simulator::install_poll() {
 
 const SettleReport& Simulator::apply(const Action& action) { return apply_from(action, nullptr); }
 
+void Simulator::rewind(const Checkpoint& checkpoint) {
+  if (checkpoint.state.x.cols() != state_.x.cols() || checkpoint.state.cell_jammed.size() != state_.cell_jammed.size() ||
+      checkpoint.state.node_pinned.size() != state_.node_pinned.size())
+    throw std::invalid_argument("Simulator::rewind: the checkpoint is of another mesh");
+  state_ = checkpoint.state;
+  settle_memory_ = checkpoint.memory;
+  last_ = checkpoint.last;
+}
+
 const SettleReport& Simulator::apply(const Action& action, const Eigen::Matrix3Xd& start) {
   if (start.cols() != state_.x.cols())
     throw std::invalid_argument("Simulator::apply: start has " + std::to_string(start.cols()) + " points, the mesh " +

@@ -90,6 +90,19 @@ class Simulator {
   const DeviceState& state() const { return state_; }
   const SettleReport& last_settle() const { return last_; }
 
+  // The state as it is, with what its settles carry to the next one: a
+  // planner's trial action it may not keep goes back here (rewind), so the
+  // actions it keeps replay from rest to the same states.
+  struct Checkpoint {
+    DeviceState state;
+    SettleMemory memory;
+    SettleReport last;
+  };
+  Checkpoint checkpoint() const { return {state_, settle_memory_, last_}; }
+  // Back to a checkpoint of this simulator. Throws std::invalid_argument if
+  // it is of another mesh.
+  void rewind(const Checkpoint& checkpoint);
+
   // Validates (std::invalid_argument naming what is wrong), applies and
   // settles. Repeating an action changes nothing. Throws NoEquilibrium if no
   // equilibrium is found, SettleInterrupted if interrupted (the state is left
