@@ -61,6 +61,7 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
   int jumps = 0;
   while (previous < p_max) {
     const double pressure = std::min(previous + step, p_max);
+    const PlanCheckpoint before = plan_checkpoint(sim, result);
     if (!apply(pressure)) {
       // A free net folds only where it is slack, just past levelling on a
       // large array: more pressure tautens it. Anything jammed or pinned: smaller steps.
@@ -74,7 +75,8 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
       continue;
     }
     jumps = 0;
-    if (v.bisect_pins && step > kMinStepPa && overshoots() && apply(previous)) {
+    if (v.bisect_pins && step > kMinStepPa && overshoots()) {  // taken back (plan_checkpoint)
+      rewind_plan(sim, result, before);
       step /= 2.0;
       continue;
     }
@@ -89,18 +91,20 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
   }
   // End pressure: with the pins and jams set, lower pressure lets the cells
   // between pins relax from the bulge that lifting the highest nodes needed.
-  // Scan down towards the levelling pressure and end at the best one.
+  // Scan down towards the levelling pressure and end at the best one
+  // (rewound to).
   const auto score = [&] {
     return mesh_point_score(request, point_heights(mesh, sim.state().x) * 1000.0);
   };
-  double best_pressure = sim.state().pressure_pa, best_r = score();
+  double best_r = score();
+  PlanCheckpoint best = plan_checkpoint(sim, result);
   for (double f : kEndPressureFactors) {
     const double p = f * p_level;
     if (p >= sim.state().pressure_pa || p > p_max) continue;
     if (!apply(p)) continue;
-    if (const double r = score(); r > best_r) best_r = r, best_pressure = p;
+    if (const double r = score(); r > best_r) best_r = r, best = plan_checkpoint(sim, result);
   }
-  if (sim.state().pressure_pa != best_pressure) apply(best_pressure);
+  rewind_plan(sim, result, best);
   result.final_state = sim.state();
   return result;
 }

@@ -122,21 +122,19 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
                          std::min(options_.min_step_pa, step), step)
             : step;
     const double next = std::max(pressure - trial, p_floor);
-    const Simulator::Checkpoint before = sim.checkpoint();
-    const std::size_t steps_before_trial = result.steps.size();
+    const PlanCheckpoint before = plan_checkpoint(sim, result);
     if (!apply(next)) {
       if (trial <= options_.min_step_pa) break;
       step = trial / 2.0;
       continue;
     }
     if (trial > options_.min_step_pa && free_node_height_error([&](double dz) { return dz < -tolerance_m; })) {
-      sim.rewind(before);
-      result.steps.resize(steps_before_trial);
+      rewind_plan(sim, result, before);
       step = trial / 2.0;
       continue;
     }
     last_step = pressure - next;
-    z_before = before.state.x.row(2).transpose();
+    z_before = before.simulator.state.x.row(2).transpose();
     pressure = next;
     const std::size_t steps_before = result.steps.size();
     const bool nodes_done = pin_reached_nodes(sim, goal_x, Reach::kFromAbove, result, callbacks);
@@ -150,7 +148,7 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
   // End pressure: with the pins and jams set, cells between pins sag below
   // levelling and bulge above it. From the pressure reached, step through
   // the end pressures downwards while the score improves, else upwards
-  // while it improves (a hill climb), and end at the best.
+  // while it improves (a hill climb), and end at the best (rewound to).
   const auto score = [&] {
     return mesh_point_score(request, point_heights(mesh, sim.state().x) * 1000.0);
   };
@@ -160,19 +158,20 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
     if (p < pressure) below.insert(below.begin(), p);
     else if (p > pressure && p <= p_max) above.push_back(p);
   }
-  double best_pressure = pressure, best_r = score();
+  double best_r = score();
+  PlanCheckpoint best = plan_checkpoint(sim, result);
   for (const std::vector<double>* direction : {&below, &above}) {
-    const double from = best_pressure;
+    bool improved = false;
     for (double p : *direction) {
       if (!apply(p)) break;
       const double r = score();
       if (!(r > best_r)) break;
-      best_r = r, best_pressure = p;
+      best_r = r, best = plan_checkpoint(sim, result), improved = true;
     }
-    if (best_pressure != from) break;
+    rewind_plan(sim, result, best);
+    if (improved) break;
   }
-  if (sim.state().pressure_pa != best_pressure) apply(best_pressure);
-  progress(1.0, best_pressure, "done");
+  progress(1.0, sim.state().pressure_pa, "done");
   result.final_state = sim.state();
   return result;
 }

@@ -107,6 +107,15 @@ bool try_planned(Simulator& sim, const Action& action, PlanResult& result, const
   }
 }
 
+PlanCheckpoint plan_checkpoint(const Simulator& sim, const PlanResult& result) {
+  return {sim.checkpoint(), result.steps.size()};
+}
+
+void rewind_plan(Simulator& sim, PlanResult& result, const PlanCheckpoint& checkpoint) {
+  sim.rewind(checkpoint.simulator);
+  result.steps.resize(std::min(result.steps.size(), checkpoint.steps));
+}
+
 bool pin_reached_nodes(Simulator& sim, const Eigen::Matrix3Xd& goal_x, Reach reach, PlanResult& result,
                        const PlanCallbacks& callbacks) {
   const Mesh& mesh = sim.mesh();

@@ -118,6 +118,18 @@ void apply_planned(Simulator& sim, const Action& action, PlanResult& result, con
 // action goes to result.refused with the reason, and false is returned.
 bool try_planned(Simulator& sim, const Action& action, PlanResult& result, const PlanCallbacks& callbacks);
 
+// A point of a plan to come back to: the simulator's checkpoint and how many
+// steps the plan had. A planner that tries an action it may not keep (a
+// pressure step too far, an end pressure that scores worse) rewinds to it
+// rather than acting its way back, so the plan, and the device, never make
+// the action, and the state it ends in is the one it scored.
+struct PlanCheckpoint {
+  Simulator::Checkpoint simulator;
+  std::size_t steps = 0;
+};
+PlanCheckpoint plan_checkpoint(const Simulator& sim, const PlanResult& result);
+void rewind_plan(Simulator& sim, PlanResult& result, const PlanCheckpoint& checkpoint);
+
 // The side from which a rising (Algorithm 2) or falling (from-above)
 // surface reaches its goal: a node's height or a cell's curvature at or
 // above the goal's, or at or below it.
