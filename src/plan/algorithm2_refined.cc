@@ -5,7 +5,6 @@
 #include <optional>
 #include <stdexcept>
 
-#include "metrics/correlation.h"
 #include "sim/surface_measures.h"
 
 namespace hj {
@@ -93,9 +92,7 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
   // between pins relax from the bulge that lifting the highest nodes needed.
   // Scan down towards the levelling pressure and end at the best one
   // (rewound to).
-  const auto score = [&] {
-    return mesh_point_score(request, point_heights(mesh, sim.state().x) * 1000.0);
-  };
+  const auto score = [&] { return mesh_point_score(request, mesh, sim.state()); };
   double best_r = score();
   PlanCheckpoint best = plan_checkpoint(sim, result);
   for (double f : kEndPressureFactors) {
@@ -160,7 +157,7 @@ PlanResult Algorithm2Refined::plan(const PlanRequest& request, const PlanCallbac
       last_error = e.what();  // no equilibrium on this path: the other variants may find one
       continue;
     }
-    const double r = mesh_point_score(request, point_heights(mesh, candidate.final_state.x) * 1000.0);
+    const double r = mesh_point_score(request, mesh, candidate.final_state);
     if (!best || r > best_r) best_r = r, best = std::move(candidate);
   }
   if (!best) throw std::runtime_error("algorithm2-refined: no variant reached equilibrium: " + last_error);

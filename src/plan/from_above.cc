@@ -6,7 +6,6 @@
 #include <limits>
 #include <vector>
 
-#include "metrics/correlation.h"
 #include "sim/surface_measures.h"
 
 namespace hj {
@@ -111,7 +110,8 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
   double pressure = sim.state().pressure_pa;
   const double top = pressure;
   double step = options_.decrement_pa;
-  Eigen::VectorXd z_before;  // the heights before the last step kept, and its size
+  // The last step kept: the point heights before it, and its size (Pa).
+  Eigen::VectorXd z_before;
   double last_step = 0.0;
   while (pressure > p_floor) {
     // Within the step as halved, short of where the nodes are predicted to
@@ -149,9 +149,7 @@ PlanResult FromAbove::plan(const PlanRequest& request, const PlanCallbacks& call
   // levelling and bulge above it. From the pressure reached, step through
   // the end pressures downwards while the score improves, else upwards
   // while it improves (a hill climb), and end at the best (rewound to).
-  const auto score = [&] {
-    return mesh_point_score(request, point_heights(mesh, sim.state().x) * 1000.0);
-  };
+  const auto score = [&] { return mesh_point_score(request, mesh, sim.state()); };
   std::vector<double> below, above;
   for (double f : kEndPressureFactors) {
     const double p = f * p_level;

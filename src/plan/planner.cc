@@ -186,6 +186,10 @@ double mesh_point_score(const PlanRequest& request, const Eigen::MatrixXd& heigh
   return -std::sqrt(error.isFinite().select(error.square(), 0.0).sum() / static_cast<double>(finite));
 }
 
+double mesh_point_score(const PlanRequest& request, const Mesh& mesh, const DeviceState& state) {
+  return mesh_point_score(request, point_heights(mesh, state.x) * 1000.0);
+}
+
 double plan_max_pressure(double option_pa, const SurfaceParameters& params) {
   return option_pa > 0.0 ? std::min(option_pa, params.max_pressure_pa) : params.max_pressure_pa;
 }

@@ -160,6 +160,8 @@ double plan_score(const PlanRequest& request, const Mesh& mesh, const DeviceStat
 // The same at the mesh points only (heights_mm as point_heights, in mm):
 // what a planner's own choices (an end pressure, a variant) maximise.
 double mesh_point_score(const PlanRequest& request, const Eigen::MatrixXd& heights_mm);
+// The same of a state's heights.
+double mesh_point_score(const PlanRequest& request, const Mesh& mesh, const DeviceState& state);
 
 // A planner's pressure ceiling: its option (0: none) capped by the device's.
 double plan_max_pressure(double option_pa, const SurfaceParameters& params);
