@@ -8,14 +8,20 @@ namespace hj {
 
 void SuiteSparseAmdOrdering::operator()(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& symmetric,
                                         PermutationType& perm) const {
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> a = symmetric;
-  a.makeCompressed();
-  const int n = static_cast<int>(a.rows());
+  // AMD reads the compressed arrays; Eigen passes the pattern compressed.
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> copy;
+  const auto* a = &symmetric;
+  if (!symmetric.isCompressed()) {
+    copy = symmetric;
+    copy.makeCompressed();
+    a = &copy;
+  }
+  const int n = static_cast<int>(a->rows());
   std::vector<int> order(n);
   double control[AMD_CONTROL], info[AMD_INFO];
   amd_defaults(control);
   perm.resize(n);
-  if (amd_order(n, a.outerIndexPtr(), a.innerIndexPtr(), order.data(), control, info) < AMD_OK) {
+  if (amd_order(n, a->outerIndexPtr(), a->innerIndexPtr(), order.data(), control, info) < AMD_OK) {
     perm.setIdentity();
     return;
   }
