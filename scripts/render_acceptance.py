@@ -42,10 +42,12 @@ CASES = {
 
 def sequences(rows, cols):
     """Three known sequences per array size: rising pressure, jams and pins on the way.
-    Pressures are for 3 x 4; a larger array domes higher at the same pressure,
-    so they are scaled by (3 / rows)^2 (6 x 8: 1200 Pa -> 300 Pa)."""
+    Pressures are for 3 x 4. Above levelling (the pressure that carries the membrane's
+    weight, the same at every size) a dome's height over its span goes as
+    ((P - P_level) L / k)^(1/3), so the same shapes scaled with the array, as the paper
+    scales goals, take P_level + (P - P_level) x 3 / rows (6 x 8: 1200 Pa -> 756 Pa)."""
     r2, c2 = rows // 2, cols // 2
-    scale = (3.0 / rows) ** 2
+    scale = 3.0 / rows
     return {name: [scaled(c, scale) for c in seq] for name, seq in {
         "ridge": ["set_pressure 1200", "jam 0 1", f"pin 1 1", "set_pressure 2400", f"jam {rows - 2} {cols - 2}",
                   f"jam {rows - 1} 0", "set_pressure 3000"],
@@ -56,9 +58,16 @@ def sequences(rows, cols):
     }.items()}
 
 
+# The membrane's weight per area in the model's defaults (0.55 kg per 12 cells of
+# 38 mm, docs/model.md): below it the membrane sags, above it domes.
+LEVELLING_PA = 0.55 / 12 * 9.81 / 0.038 ** 2
+
+
 def scaled(command, scale):
     words = command.split(" ")
-    return f"set_pressure {float(words[1]) * scale:g}" if words[0] == "set_pressure" else command
+    if words[0] != "set_pressure":
+        return command
+    return f"set_pressure {LEVELLING_PA + (float(words[1]) - LEVELLING_PA) * scale:.0f}"
 
 
 class Line:
