@@ -56,15 +56,20 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
       }
     return false;
   };
-  double previous = 0.0, step = v.increment_pa;
+  // Jams (and, with a levelling margin, any action) from here up.
+  const double act_from = v.jam_below_levelling ? 0.0 : request.levelling_margin * p_level;
+  const bool carry_across = !v.jam_below_levelling && request.levelling_margin > 1.0;
+  double previous = 0.0, step = v.increment_pa, carry_to = act_from;
   int jumps = 0;
   while (previous < p_max) {
-    const double pressure = std::min(previous + step, p_max);
+    double pressure = std::min(previous + step, p_max);
+    if (carry_across && pressure < carry_to && is_free_net(mesh, sim.state())) pressure = std::min(carry_to, p_max);
     const PlanCheckpoint before = plan_checkpoint(sim, result);
     if (!apply(pressure)) {
       // A free net folds only where it is slack, just past levelling on a
       // large array: more pressure tautens it. Anything jammed or pinned: smaller steps.
       if (is_free_net(mesh, sim.state()) && jumps < kMaxJumps && pressure < p_max) {
+        if (carry_across && pressure >= carry_to) carry_to = pressure + step;
         step *= 2.0;
         ++jumps;
         continue;
@@ -82,7 +87,7 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
     previous = pressure;
     const std::size_t steps_before = result.steps.size();
     const bool nodes_done = pin_reached_nodes(sim, goal_x, Reach::kFromBelow, result, quiet);
-    const bool may_jam = v.jam_below_levelling || pressure >= p_level;
+    const bool may_jam = pressure >= act_from;
     const bool cells_done = may_jam ? jam_reached_cells(sim, goal_curvature, Reach::kFromBelow, result, quiet)
                                     : every_cell_jammed(mesh, sim.state());
     if (nodes_done && cells_done) break;
@@ -96,6 +101,7 @@ PlanResult run_variant(const PlanRequest& request, const Variant& v, double p_ma
   double best_r = score();
   PlanCheckpoint best = plan_checkpoint(sim, result);
   for (double f : kEndPressureFactors) {
+    if (carry_across && f < request.levelling_margin) continue;
     const double p = f * p_level;
     if (p >= sim.state().pressure_pa || p > p_max) continue;
     if (!apply(p)) continue;

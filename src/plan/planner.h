@@ -33,6 +33,14 @@ struct PlanRequest {
   // if the caller has it; empty: plans are compared at the mesh points.
   Eigen::MatrixXd goal_image;
   PlanScoring scoring = PlanScoring::kCorrelation;
+  // Up to this multiple of the levelling pressure a device departs most from
+  // the model: where its sag turns into a dome hangs on its mass, its
+  // stiffening and the mesh (a free 6 x 8 net at 1.12 x levelling domes at
+  // p = 4 and still sags at p = 8). The variants that jam only above levelling
+  // (algorithm2-levelled) take no action below it and carry the free net
+  // there in one step. 1: at the levelling pressure, for plans judged in the
+  // model; a render on a device sets more (server/render_loop.cc).
+  double levelling_margin = 1.0;
 };
 
 struct PlanCallbacks {
@@ -166,7 +174,9 @@ double mesh_point_score(const PlanRequest& request, const Mesh& mesh, const Devi
 // A planner's pressure ceiling: its option (0: none) capped by the device's.
 double plan_max_pressure(double option_pa, const SurfaceParameters& params);
 
-// Checks a request's goal against its mesh (shape, finite values).
+// Checks a request's goal against its mesh (shape, finite values) and its
+// levelling margin (1 to kMaxLevellingMargin).
+constexpr double kMaxLevellingMargin = 4.0;
 void validate_plan_request(const PlanRequest& request, const Mesh& mesh);
 
 }  // namespace hj
