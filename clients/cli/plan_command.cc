@@ -37,6 +37,7 @@ constexpr const char* kPlanUsage =
     "                      [--max-height-mm H | --heights absolute] [--region x0,y0,x1,y1] [--hue] [--json]\n"
     "                      [--up-axis [-]x|y|z] [--view-resolution N]\n"
     "                      [--region-lonlat lon0,lat0,lon1,lat1] [--encoding E] [--no-sidecar] [--align]\n"
+    "                      [--levelling-margin M]\n"
     "Plans the actions that make the display show GOAL (a height image: CSV, PNG,\n"
     "TIFF or GeoTIFF, SRTM .hgt; or a mesh: STL, OBJ, PLY, glTF/GLB, 3MF, seen from\n"
     "above) and writes DIR/plan.json (steps in the session format, correlation,\n"
@@ -65,13 +66,17 @@ constexpr const char* kPlanUsage =
     "  --align               shift the goal's window by up to half a cell and scale it to\n"
     "                        0.8..1 of its side so its valleys fall on nodes; plans the\n"
     "                        unaligned goal and the best few candidates and keeps the best\n"
-    "                        (plan.json \"align\": transform and gain; docs/planners.md)\n";
+    "                        (plan.json \"align\": transform and gain; docs/planners.md)\n"
+    "  --levelling-margin M  for a device: algorithm2-levelled (alone or in the portfolio)\n"
+    "                        acts only from M x the levelling pressure, 1 to 4 (default 1;\n"
+    "                        a render plans with 1.5; docs/planners.md)\n";
 static_assert(std::string_view(kDefaultPlanner) == "portfolio", "kPlanUsage names the default planner");
 
 struct PlanArgs {
   std::string goal, out, planner = kDefaultPlanner, region, region_lonlat;
   int rows = 0, cols = 0, segments = 4;
   double max_height_mm = 0.0;  // 0: the array's default relief (default_relief_mm)
+  double levelling_margin = 1.0;
   bool hue = false, json = false, align = false;
   GoalHeights heights = GoalHeights::kScaled;
   ImportOptions import;
@@ -103,6 +108,7 @@ PlanArgs parse_plan_args(const std::vector<std::string>& args) {
     }
     else if (a == "--json") out.json = true;
     else if (a == "--align") out.align = true;
+    else if (a == "--levelling-margin") out.levelling_margin = parse_number(a, value());
     else if (a == "--heights") out.heights = parse_goal_heights(value());
     else if (a == "--max-height-mm") {
       out.max_height_mm = parse_number(a, value());
@@ -160,6 +166,7 @@ int plan(const PlanArgs& args) {
                       goal_to_mesh(goal, mesh, args.heights, args.max_height_mm), {}, goal.z};
   const bool absolute = args.heights == GoalHeights::kAbsolute;
   if (absolute) request.scoring = PlanScoring::kHeightError;
+  request.levelling_margin = args.levelling_margin;
   const double relief_mm = absolute ? request.goal_mm.maxCoeff() - request.goal_mm.minCoeff()
                                     : relief_or_default_mm(args.max_height_mm, geometry);
   const auto planner = make_planner(args.planner);

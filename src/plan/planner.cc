@@ -51,10 +51,12 @@ void validate_plan_request(const PlanRequest& request, const Mesh& mesh) {
     throw std::invalid_argument(err.str());
   }
   if (!g.allFinite()) throw std::invalid_argument("goal heights must all be finite numbers (mm)");
-  if (!(request.levelling_margin >= 1.0 && request.levelling_margin <= kMaxLevellingMargin))
-    throw std::invalid_argument("levelling margin " + std::to_string(request.levelling_margin) +
-                                " is outside [1, " + std::to_string(kMaxLevellingMargin) +
-                                "] (a multiple of the levelling pressure)");
+  if (!(request.levelling_margin >= 1.0 && request.levelling_margin <= kMaxLevellingMargin)) {
+    std::ostringstream err;
+    err << "levelling margin " << request.levelling_margin << " is outside [1, " << kMaxLevellingMargin
+        << "] (a multiple of the levelling pressure)";
+    throw std::invalid_argument(err.str());
+  }
 }
 
 SimulatorOptions simulator_options(const PlanRequest& request, const PlanCallbacks& callbacks) {
