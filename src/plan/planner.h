@@ -36,7 +36,7 @@ struct PlanRequest {
   // Up to this multiple of the levelling pressure a device departs most from
   // the model: where its sag turns into a dome hangs on its mass, its
   // stiffening and the mesh (a free 6 x 8 net at 1.12 x levelling domes at
-  // p = 4 and still sags at p = 8). The variants that jam only above levelling
+  // p = 4 and, stiffening, still sags at p = 8). The variants that jam only above levelling
   // (algorithm2-levelled) take no action below it and carry the free net
   // there in one step. 1: at the levelling pressure, for plans judged in the
   // model; a render on a device sets more (server/render_loop.cc).
