@@ -30,9 +30,9 @@ struct DirectionResult {
 using PointCost = std::function<double(const ModelParams&)>;
 
 // Walks one direction, each point costed by `cost` (a replay of the
-// dataset, or a measurement effect's reused one). Replays are cold, not
-// from the last point's states: the points are 3 x apart, and warm settles
-// crawl from that far start, slower than cold ones, some to other equilibria.
+// dataset, or a measurement effect's reused one). A point's replay moves
+// each step as the start's replay moved it (replay_session's warm start),
+// which is nearer its equilibrium than the step's cold start even 3 x away.
 DirectionResult walk(const ModelParams& start, const Direction& d, const EffectScanOptions& options,
                      const PointCost& cost) {
   DirectionResult out;
@@ -105,13 +105,16 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
       results[k + 1] = walk(start, directions[k], options, [&](const ModelParams& p) { return at_points.sum_of_squares(p); });
     for (const auto& r : results) out.failed += r.failed;
   } else {
-    results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, threads);
+    std::vector<ReplayTrace> start_traces;
+    results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, threads,
+                                                    std::numeric_limits<double>::infinity(), nullptr, &start_traces);
     results[0].replays = 1;
     parallel_for(
         static_cast<int>(directions.size()),
         [&](int k) {
           results[k + 1] = walk(start, directions[k], options, [&](const ModelParams& p) {
-            return dataset_sum_of_squares(dataset, p, point_replay, session_threads);
+            return dataset_sum_of_squares(dataset, p, point_replay, session_threads,
+                                          std::numeric_limits<double>::infinity(), &start_traces);
           });
         },
         replay.threads);

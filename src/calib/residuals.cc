@@ -220,7 +220,8 @@ Eigen::VectorXd capture_residuals(const MeasuredSession& session, const std::vec
 }
 
 double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                              int session_threads, double bound) {
+                              int session_threads, double bound, const std::vector<ReplayTrace>* warm_start,
+                              std::vector<ReplayTrace>* traces) {
   ReplayOptions serial = options;
   serial.threads = 1;
   const int n = static_cast<int>(dataset.sessions.size());
@@ -228,6 +229,7 @@ double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params,
   std::atomic<bool> failed{false}, past_bound{false};
   std::atomic<double> running{0.0};
   const bool bounded = bound < std::numeric_limits<double>::infinity();
+  if (traces) traces->assign(n, ReplayTrace());
   parallel_for(
       n,
       [&](int s) {
@@ -235,7 +237,12 @@ double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params,
         const MeasuredSession& session = dataset.sessions[s];
         try {
           const CaptureSink check = bounded ? bound_check(session, running, bound) : CaptureSink{};
-          sums[s] = capture_residuals(session, predict(session, params, serial, nullptr, nullptr, check)).squaredNorm();
+          const ReplayTrace* hint = warm_start && s < static_cast<int>(warm_start->size()) && !(*warm_start)[s].empty()
+                                        ? &(*warm_start)[s]
+                                        : nullptr;
+          sums[s] = capture_residuals(session, predict(session, params, serial, hint, traces ? &(*traces)[s] : nullptr,
+                                                       check))
+                        .squaredNorm();
         } catch (const PastBound&) {
           past_bound = true;
         } catch (const SettleInterrupted&) {

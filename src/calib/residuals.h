@@ -130,8 +130,12 @@ Eigen::VectorXd capture_residuals(const MeasuredSession& session, const std::vec
 // above the bound (the sum so far) is returned. A session with no
 // equilibrium after that point is not reached, so it does not make the
 // sum infinite.
+// With warm_start (a trace per session, empty for none), each session's
+// settles start from those states (replay_session); with traces, each
+// session's settled states are recorded there.
 double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                              int session_threads = 1,
-                              double bound = std::numeric_limits<double>::infinity());
+                              int session_threads = 1, double bound = std::numeric_limits<double>::infinity(),
+                              const std::vector<ReplayTrace>* warm_start = nullptr,
+                              std::vector<ReplayTrace>* traces = nullptr);
 
 }  // namespace hj
