@@ -119,7 +119,7 @@ rm -rf "$base" && mkdir -p "$base"
 IFS=, read -ra chosen <<<"$sessions"
 for s in "${chosen[@]}"; do
   [[ -f "$source_dataset/$s/session.json" ]] || { echo "synth_effects.sh: no session $s in $source_dataset" >&2; exit 2; }
-  ln -s "$source_dataset/$s" "$base/$s"
+  ln -sfn "$source_dataset/$s" "$base/$s"  # -n: never a link inside the source session
 done
 
 # The cases in the order --cases gives them (cheapest first, say), else all.
