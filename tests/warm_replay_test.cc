@@ -9,6 +9,10 @@
 
 #include <fstream>
 
+#include <limits>
+
+#include "calib/dataset.h"
+#include "calib/replay_tally.h"
 #include "calib/residuals.h"
 #include "calib/session.h"
 #include "calib_synthetic.h"
@@ -76,6 +80,31 @@ TEST(WarmReplay, UnderStiffJamsAWarmReplayReachesTheColdEquilibriaInFewerSteps) 
     // cold replay's steps (the last replay's absolute states: 83 of 147).
     if (factor < 1.05) EXPECT_LT(2 * warm.solver_steps, cold.solver_steps);
     else EXPECT_LT(warm.solver_steps, cold.solver_steps);
+  }
+}
+
+// A dataset replayed warm from its own traces gives the same sum of squares,
+// and the tally tells the cold replays from the warm ones (where the time goes).
+TEST(WarmReplay, TheTallyCountsColdReplaysApart) {
+  const Dataset d = select_sessions(
+      read_dataset(std::filesystem::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline"), {"jammed-sweep", "mixed-1"},
+      true);
+  ReplayOptions replay = fitting_replay({});
+  ReplayTally tally;
+  replay.tally = &tally;
+  std::vector<ReplayTrace> traces;
+  const double inf = std::numeric_limits<double>::infinity();
+  const ModelParams truth = testing_support::true_tiny_baseline();
+  const double cold = dataset_sum_of_squares(d, truth, replay, 1, inf, nullptr, &traces);
+  ASSERT_EQ(traces.size(), 2u);
+  const double warm = dataset_sum_of_squares(d, truth, replay, 1, inf, &traces);
+  EXPECT_NEAR(warm, cold, 1e-9 * cold);
+  for (const ReplayTally::Entry& e : tally.entries()) {
+    SCOPED_TRACE(e.session);
+    EXPECT_EQ(e.replays, 2);
+    EXPECT_EQ(e.cold, 1);
+    EXPECT_GT(e.cold_cpu_s, 0.0);
+    EXPECT_LT(e.cold_cpu_s, e.cpu_s);
   }
 }
 

@@ -54,19 +54,24 @@ nlohmann::json time_split(const nlohmann::json& timing) {
   return out;
 }
 
-// " (N failed, X s CPU)": a replay with no equilibrium can cost many good ones.
-std::string failed_replays_text(const ReplayTally::Entry& e) {
-  if (e.failed == 0) return "";
-  char text[80];
-  std::snprintf(text, sizeof text, " (%ld failed, %.1f s CPU)", e.failed, e.failed_cpu_s);
-  return text;
+// " (N cold, X s CPU; M failed, Y s CPU)": a cold replay (no warm start) costs
+// several warm ones, and a replay with no equilibrium many good ones.
+std::string replay_detail_text(const ReplayTally::Entry& e) {
+  char text[120];
+  std::snprintf(text, sizeof text, " (%ld cold, %.1f s CPU", e.cold, e.cold_cpu_s);
+  std::string out = text;
+  if (e.failed > 0) {
+    std::snprintf(text, sizeof text, "; %ld failed, %.1f s CPU", e.failed, e.failed_cpu_s);
+    out += text;
+  }
+  return out + ")";
 }
 
 nlohmann::json replays_json(const ReplayTally& tally) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& e : tally.entries())
     out.push_back({{"session", e.session}, {"replays", e.replays}, {"failed", e.failed}, {"cpu_s", e.cpu_s},
-                   {"failed_cpu_s", e.failed_cpu_s},
+                   {"failed_cpu_s", e.failed_cpu_s}, {"cold", e.cold}, {"cold_cpu_s", e.cold_cpu_s},
                    {"cpu_s_per_replay", e.replays ? e.cpu_s / e.replays : 0.0}});
   return out;
 }
@@ -124,7 +129,7 @@ int diagnose_dataset(const CalibArgs& args) {
   for (const auto& e : tally.entries())
     std::printf("  replays of %-20s %5ld x %6.3f s CPU = %7.1f s%s\n", e.session.c_str(), e.replays,
                 e.replays ? e.cpu_s / e.replays : 0.0, e.cpu_s,
-                failed_replays_text(e).c_str());
+                replay_detail_text(e).c_str());
   std::printf("final model: %s; %s\n", fit_quality_sentence(d).c_str(),
               d.goodness.explained ? "consistent with the sensor's noise" : "NOT explained by the sensor's noise");
   std::printf("%s\nwrote %s in %.1f s (CPU %.1f s)\n", verdict_text.c_str(), (out / "diagnosis.json").c_str(), seconds,

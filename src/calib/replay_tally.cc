@@ -4,7 +4,7 @@
 
 namespace hj {
 
-void ReplayTally::add(const std::string& session, double cpu_s, bool ok) {
+void ReplayTally::add(const std::string& session, double cpu_s, bool ok, bool warm) {
   std::lock_guard lock(mutex_);
   Entry* entry = nullptr;
   for (auto& e : entries_)
@@ -12,6 +12,7 @@ void ReplayTally::add(const std::string& session, double cpu_s, bool ok) {
   if (!entry) entry = &entries_.emplace_back(Entry{session});
   ++entry->replays;
   if (!ok) ++entry->failed, entry->failed_cpu_s += cpu_s;
+  if (!warm) ++entry->cold, entry->cold_cpu_s += cpu_s;
   entry->cpu_s += cpu_s;
 }
 

@@ -17,10 +17,12 @@ class ReplayTally {
     long failed = 0;     // replays that threw (no equilibrium)
     double cpu_s = 0.0;  // thread CPU time of all its replays
     double failed_cpu_s = 0.0;  // ... of which in the failed ones
+    long cold = 0;              // replays with no warm start (replay_session)
+    double cold_cpu_s = 0.0;    // ... and their CPU time
   };
 
-  // Thread-safe.
-  void add(const std::string& session, double cpu_s, bool ok);
+  // Thread-safe. warm: the replay was warm-started from another's trace.
+  void add(const std::string& session, double cpu_s, bool ok, bool warm = false);
   // In order of first appearance.
   std::vector<Entry> entries() const;
   long replays() const;

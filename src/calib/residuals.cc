@@ -36,13 +36,13 @@ std::vector<PredictedCapture> predict(const MeasuredSession& session, const Mode
   try {
     auto out = replay_session(session.session, options.segments, params.surface, simulator_options(params, options),
                               {}, warm_start, trace, on_capture);
-    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true, warm_start != nullptr);
     return out;
   } catch (const PastBound&) {
-    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true, warm_start != nullptr);
     throw;
   } catch (...) {
-    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, false);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, false, warm_start != nullptr);
     throw;
   }
 }
