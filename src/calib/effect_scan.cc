@@ -32,7 +32,7 @@ using PointCost = std::function<double(const ModelParams&)>;
 // Walks one direction, each point costed by `cost` (a replay of the
 // dataset, or a measurement effect's reused one). A point's replay moves
 // each step as the start's replay moved it (replay_session's warm start),
-// which is nearer its equilibrium than the step's cold start even 3 x away.
+// which costs less than a cold replay even 3 x away (docs/calibration.md).
 DirectionResult walk(const ModelParams& start, const Direction& d, const EffectScanOptions& options,
                      const PointCost& cost) {
   DirectionResult out;

@@ -26,7 +26,8 @@ using ReplayProgress = std::function<void(int done, int total, const SessionStep
 
 // The settled positions (3 x N, m) after each step of a replay, by step
 // (empty for a capture): recorded by one replay, they warm-start another of
-// the same session under nearby parameters (Simulator::apply with a start).
+// the same session under nearby parameters (Simulator::apply with a start:
+// the other replay's state moved as this one moved over the step).
 using ReplayTrace = std::vector<Eigen::Matrix3Xd>;
 
 // The sample grid's positions in the device frame (mm), x (nx) and y (ny),
