@@ -47,10 +47,11 @@ ModelParams fold_parameters(const std::vector<FitParameter>& parameters, const L
 }
 
 // A session's sum of squares at `params`; infinity where the model finds no
-// equilibrium.
-double session_cost(const MeasuredSession& session, const ModelParams& params, const ReplayOptions& options) {
+// equilibrium. warm and trace as session_residuals takes them.
+double session_cost(const MeasuredSession& session, const ModelParams& params, const ReplayOptions& options,
+                    const ReplayTrace* warm = nullptr, ReplayTrace* trace = nullptr) {
   try {
-    return session_residuals(session, params, options).squaredNorm();
+    return session_residuals(session, params, options, warm, trace).squaredNorm();
   } catch (const SettleInterrupted&) {
     throw;  // the caller stopped the work: not a failed replay
   } catch (const std::exception&) {
@@ -75,13 +76,19 @@ CrossValidation cross_validate(const Dataset& dataset, const std::vector<FitPara
   // Each session's cost at the optimum, replayed as the trials are: a fit's
   // own residuals come from warm-started settles (or, for the screening,
   // from a linearisation). Where that replay fails, every trial passes (the
-  // step is taken as it is).
+  // step is taken as it is). The trials and the held-out replays start from
+  // these replays' moves (replay_session's warm start).
   const bool checked = cv.max_halvings >= 0 && !fit.active.empty();
   std::vector<double> at_optimum(sessions, 0.0);
+  std::vector<ReplayTrace> optimum_traces(sessions);
   if (checked)
     parallel_for(
-        sessions, [&](int s) { at_optimum[s] = session_cost(dataset.sessions[s], fit.params, options); },
+        sessions,
+        [&](int s) {
+          at_optimum[s] = session_cost(dataset.sessions[s], fit.params, options, nullptr, &optimum_traces[s]);
+        },
         options.threads);
+  const auto warm = [&](int s) { return optimum_traces[s].empty() ? nullptr : &optimum_traces[s]; };
   std::vector<double> sum_sq(sessions, 0.0);
   std::vector<long> count(sessions, 0);
   parallel_for(
@@ -100,7 +107,7 @@ CrossValidation cross_validate(const Dataset& dataset, const std::vector<FitPara
             const ModelParams trial = fold_parameters(parameters, fit, step, t);
             double cost = 0.0;
             for (int other = 0; other < sessions && cost <= optimum; ++other)
-              if (other != s) cost += session_cost(dataset.sessions[other], trial, options);
+              if (other != s) cost += session_cost(dataset.sessions[other], trial, options, warm(other));
             if (cost <= optimum) {
               out.fold_params[s] = trial;
               out.fold_step[s] = t;
@@ -108,7 +115,7 @@ CrossValidation cross_validate(const Dataset& dataset, const std::vector<FitPara
             }
           }
         }
-        const Eigen::VectorXd r = session_residuals(dataset.sessions[s], out.fold_params[s], options);
+        const Eigen::VectorXd r = session_residuals(dataset.sessions[s], out.fold_params[s], options, warm(s));
         sum_sq[s] = r.squaredNorm();
         count[s] = r.size();
         out.session_rmse_mm[s] = r.size() ? std::sqrt(sum_sq[s] / r.size()) : 0.0;

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "calib/cross_validation.h"
 #include "calib/effect_scan.h"
 #include "calib/levelling.h"
 #include "calib/residuals.h"
@@ -49,6 +50,20 @@ void BM_SessionResiduals(benchmark::State& state, const std::string& name) {
 BENCHMARK_CAPTURE(BM_SessionResiduals, unjammed_sweep, std::string("unjammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SessionResiduals, jammed_sweep, std::string("jammed-sweep"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SessionResiduals, paper_sequence, std::string("paper-sequence"))->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Leave-one-session-out of a fitted baseline (calib/cross_validation.h), as
+// diagnose judges every model: each fold's checked step replays the other
+// sessions, then the held-out one. jammed-sweep, mixed-1, paper-sequence.
+void BM_CrossValidation(benchmark::State& state) {
+  static const hj::Dataset d =
+      hj::select_sessions(hj::read_dataset(kBaseline), {"jammed-sweep", "mixed-1", "paper-sequence"}, true);
+  hj::LeastSquaresOptions options;
+  options.max_iterations = 6;
+  options.replay.threads = 1;
+  static const hj::LeastSquaresResult fit = hj::fit_least_squares(d, true_params(), hj::fit_parameters({}), options);
+  for (auto _ : state) benchmark::DoNotOptimize(hj::cross_validate(d, hj::fit_parameters({}), fit, options.replay));
+}
+BENCHMARK(BM_CrossValidation)->Unit(benchmark::kMillisecond);
 
 // The levelling crossing with its 95 % interval (the mass interval of a
 // fit), on the demo's unjammed sweep.
