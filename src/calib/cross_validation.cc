@@ -88,7 +88,7 @@ CrossValidation cross_validate(const Dataset& dataset, const std::vector<FitPara
           at_optimum[s] = session_cost(dataset.sessions[s], fit.params, options, nullptr, &optimum_traces[s]);
         },
         options.threads);
-  const auto warm = [&](int s) { return optimum_traces[s].empty() ? nullptr : &optimum_traces[s]; };
+  const auto warm = [&](int s) { return session_trace(&optimum_traces, s); };
   std::vector<double> sum_sq(sessions, 0.0);
   std::vector<long> count(sessions, 0);
   parallel_for(

@@ -147,7 +147,7 @@ class ScaledModel {
   }
 
   const ReplayTrace* hint(int session) const {
-    return cache_traces_.empty() || cache_traces_[session].empty() ? nullptr : &cache_traces_[session];
+    return session_trace(&cache_traces_, session);
   }
 
   const Dataset& dataset_;

@@ -185,9 +185,8 @@ class ChordRefit {
     parallel_for(
         sessions,
         [&](int s) {
-          const ReplayTrace* hint = traces.empty() || traces[s].empty() ? nullptr : &traces[s];
           r.segment(rows[s], rows[s + 1] - rows[s]) =
-              session_residuals(dataset_.sessions[s], params, replay_, hint, &next[s]);
+              session_residuals(dataset_.sessions[s], params, replay_, session_trace(&traces, s), &next[s]);
         },
         replay_.threads);
     traces = std::move(next);

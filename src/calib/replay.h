@@ -30,6 +30,12 @@ using ReplayProgress = std::function<void(int done, int total, const SessionStep
 // the other replay's state moved as this one moved over the step).
 using ReplayTrace = std::vector<Eigen::Matrix3Xd>;
 
+// Session s's trace among `traces` (one per session), or nullptr where there
+// is none to start from (no traces, too few, or an empty one).
+inline const ReplayTrace* session_trace(const std::vector<ReplayTrace>* traces, int s) {
+  return traces && s < static_cast<int>(traces->size()) && !(*traces)[s].empty() ? &(*traces)[s] : nullptr;
+}
+
 // The sample grid's positions in the device frame (mm), x (nx) and y (ny),
 // as Effect::adjust_measurement takes them.
 Eigen::VectorXd sample_x_mm(const SessionGrid& grid);

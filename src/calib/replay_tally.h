@@ -22,7 +22,7 @@ class ReplayTally {
   };
 
   // Thread-safe. warm: the replay was warm-started from another's trace.
-  void add(const std::string& session, double cpu_s, bool ok, bool warm = false);
+  void add(const std::string& session, double cpu_s, bool ok, bool warm);
   // In order of first appearance.
   std::vector<Entry> entries() const;
   long replays() const;

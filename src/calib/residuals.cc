@@ -33,16 +33,17 @@ std::vector<PredictedCapture> predict(const MeasuredSession& session, const Mode
     return replay_session(session.session, options.segments, params.surface, simulator_options(params, options), {},
                           warm_start, trace, on_capture);
   const double cpu_start = thread_cpu_seconds();
+  const bool warm = warm_start != nullptr;
   try {
     auto out = replay_session(session.session, options.segments, params.surface, simulator_options(params, options),
                               {}, warm_start, trace, on_capture);
-    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true, warm_start != nullptr);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true, warm);
     return out;
   } catch (const PastBound&) {
-    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true, warm_start != nullptr);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, true, warm);
     throw;
   } catch (...) {
-    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, false, warm_start != nullptr);
+    options.tally->add(session.session.name, thread_cpu_seconds() - cpu_start, false, warm);
     throw;
   }
 }
@@ -158,10 +159,8 @@ Evaluation evaluate_dataset(const Dataset& dataset, const ModelParams& params, c
         const MeasuredSession& measured = dataset.sessions[i];
         SessionEvaluation& result = out.sessions[i];
         result.name = measured.session.name;
-        const ReplayTrace* hint = warm_start && i < static_cast<int>(warm_start->size()) && !(*warm_start)[i].empty()
-                                      ? &(*warm_start)[i]
-                                      : nullptr;
-        result.predicted = predict(measured, params, options, hint, traces ? &(*traces)[i] : nullptr);
+        result.predicted =
+            predict(measured, params, options, session_trace(warm_start, i), traces ? &(*traces)[i] : nullptr);
         for (size_t k = 0; k < measured.captures.size(); ++k)
           result.captures.push_back(compare_capture(result.predicted[k].heights_mm, measured.captures[k].heights_mm,
                                                     measured.session.sensor_accuracy_mm));
@@ -237,12 +236,9 @@ double dataset_sum_of_squares(const Dataset& dataset, const ModelParams& params,
         const MeasuredSession& session = dataset.sessions[s];
         try {
           const CaptureSink check = bounded ? bound_check(session, running, bound) : CaptureSink{};
-          const ReplayTrace* hint = warm_start && s < static_cast<int>(warm_start->size()) && !(*warm_start)[s].empty()
-                                        ? &(*warm_start)[s]
-                                        : nullptr;
-          sums[s] = capture_residuals(session, predict(session, params, serial, hint, traces ? &(*traces)[s] : nullptr,
-                                                       check))
-                        .squaredNorm();
+          const auto predicted =
+              predict(session, params, serial, session_trace(warm_start, s), traces ? &(*traces)[s] : nullptr, check);
+          sums[s] = capture_residuals(session, predicted).squaredNorm();
         } catch (const PastBound&) {
           past_bound = true;
         } catch (const SettleInterrupted&) {
