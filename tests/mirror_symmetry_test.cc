@@ -56,6 +56,22 @@ TEST(MirrorSymmetryOf, NeedsThePositionsAndTheForcesToBeMirrored) {
   EXPECT_EQ(mirror_symmetry_of(graded, sim.state()).elements, kMirrorY);
 }
 
+// On the flat grid the springs carry no tension, so a stiffness gradient
+// leaves the forces (gravity alone) mirrored; the stiffness is not, and a
+// settle on the symmetric displacements from there failed and sent a fit's
+// replay to the careful control and another equilibrium (cell_stiffness
+// grad_x -0.3, 3 x 4, a replay's first settle).
+TEST(MirrorSymmetryOf, NeedsTheStiffnessToBeMirroredWhereTheForcesAre) {
+  const ArrayGeometry small{3, 4, 0.038, 4};
+  Simulator sim(small, SurfaceParameters::paper_defaults(small));
+  DeviceState flat = sim.state();
+  flat.x = sim.mesh().rest_positions();
+  flat.pressure_pa = 0.0;
+  const ForceModel graded(sim.mesh(), sim.params(),
+                          make_effects({"cell_stiffness"}, {{"cell_stiffness", {{"grad_x", -0.3}}}}));
+  EXPECT_EQ(mirror_symmetry_of(graded, flat).elements, kMirrorY);
+}
+
 TEST(MirrorSubspace, IsTheSymmetricDisplacementsAndReducesKToSTKS) {
   Simulator sim(kMedium, SurfaceParameters::paper_defaults(kMedium));
   DeviceState state = sim.state();

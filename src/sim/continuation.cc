@@ -353,8 +353,7 @@ void Continuation::settle_for_pushed_from() {
 
 MirrorGroup Continuation::symmetry() {
   if (!found_symmetry_)
-    found_symmetry_ =
-        options_.mirror_symmetry && k_.num_dofs() >= kMinMirrorDofs ? mirror_symmetry_of(model_, state_) : MirrorGroup{};
+    found_symmetry_ = options_.mirror_symmetry ? mirror_symmetry_of(model_, state_) : MirrorGroup{};
   return *found_symmetry_;
 }
 

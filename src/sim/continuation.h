@@ -15,11 +15,6 @@
 
 namespace hj {
 
-// Free DOFs from which a settle first tries the symmetric displacements
-// alone: the paper's 3 x 4 array (495) is fast without them, and its fits
-// keep their rounding.
-constexpr int kMinMirrorDofs = 1000;
-
 // How the shift mu follows the iterations.
 enum class StepControl {
   // mu shrinks 3x per step while steps stay under the cap, grows to keep

@@ -45,6 +45,57 @@ bool maps_onto_itself(const Mesh& mesh, const Eigen::Matrix3Xd& u, int g, double
   return true;
 }
 
+// The stiffness blocks K(p, q) of the points within the stencil, summed as
+// a force model adds them (the same 5 x 5 stencil as StiffnessMatrix).
+class StencilBlocks final : public StiffnessSink {
+ public:
+  explicit StencilBlocks(const Mesh& mesh)
+      : mesh_(mesh), blocks_(static_cast<size_t>(mesh.num_points()) * 25, Eigen::Matrix3d::Zero()) {}
+  void add(int row_point, int col_point, const Eigen::Matrix3d& block) override {
+    if (const int s = slot(row_point, col_point); s >= 0) blocks_[static_cast<size_t>(row_point) * 25 + s] += block;
+  }
+  const Eigen::Matrix3d* block(int p, int q) const {
+    const int s = slot(p, q);
+    return s < 0 ? nullptr : &blocks_[static_cast<size_t>(p) * 25 + s];
+  }
+  double largest() const {
+    double out = 0.0;
+    for (const auto& b : blocks_) out = std::max(out, b.cwiseAbs().maxCoeff());
+    return out;
+  }
+
+ private:
+  int slot(int p, int q) const {
+    const int di = mesh_.row_of(q) - mesh_.row_of(p), dj = mesh_.col_of(q) - mesh_.col_of(p);
+    return std::abs(di) > 2 || std::abs(dj) > 2 ? -1 : (di + 2) * 5 + (dj + 2);
+  }
+  const Mesh& mesh_;
+  std::vector<Eigen::Matrix3d> blocks_;
+};
+
+// Whether element g maps the stiffness onto itself, K(g p, g q) = D_g K(p, q)
+// D_g, over the free points, within `tolerance`. Forces alone miss what only
+// shows under strain: at the flat rest state the springs carry no tension,
+// so a stiffness gradient leaves the forces symmetric but not K.
+bool stiffness_maps_onto_itself(const Mesh& mesh, const StencilBlocks& k, const std::vector<char>& fixed, int g,
+                                double tolerance) {
+  const Eigen::Matrix3d d = Eigen::Vector3d(flip(g, 0), flip(g, 1), 1.0).asDiagonal();
+  for (int p = 0; p < mesh.num_points(); ++p) {
+    if (fixed[p]) continue;
+    for (int di = -2; di <= 2; ++di)
+      for (int dj = -2; dj <= 2; ++dj) {
+        const int qi = mesh.row_of(p) + di, qj = mesh.col_of(p) + dj;
+        if (qi < 0 || qj < 0 || qi >= mesh.point_rows() || qj >= mesh.point_cols()) continue;
+        const int q = mesh.index(qi, qj);
+        if (fixed[q]) continue;
+        const Eigen::Matrix3d* here = k.block(p, q);
+        const Eigen::Matrix3d* there = k.block(image(mesh, g, p), image(mesh, g, q));
+        if (!here || !there || !((*there - d * *here * d).cwiseAbs().maxCoeff() <= tolerance)) return false;
+      }
+  }
+  return true;
+}
+
 // The largest subgroup whose elements are all in `passing` (bit g set).
 MirrorGroup largest_subgroup(unsigned passing) {
   if ((passing & 0b1110u) == 0b1110u) return {0b1111u};
@@ -104,9 +155,9 @@ MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state
       passing |= 1u << g;
   MirrorGroup group = largest_subgroup(passing);
   if (group.trivial()) return group;
-  // The forces must be mirrored too: effects (a stiffness gradient), jam
-  // angles or anything else the state holds can break the symmetry that
-  // the positions have.
+  // The forces and the stiffness must be mirrored too: effects (a stiffness
+  // gradient), jam angles or anything else the state holds can break the
+  // symmetry that the positions have.
   DeviceState symmetric = state;
   symmetric.x = mirror_average(mesh, state.x, group, fixed);
   Eigen::Matrix3Xd f;
@@ -117,9 +168,14 @@ MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state
   // At an equilibrium the largest force is the residual, the difference of
   // spring forces about k h, which round asymmetrically at 1e-16 of that.
   const double tolerance = 1e-9 * (largest + model.params().spring_k * mesh.spacing());
+  StencilBlocks k(mesh);
+  model.add_stiffness(symmetric, symmetric.x, k);
+  const double stiffness_tolerance = 1e-9 * k.largest();
   unsigned forces_passing = 0;
   for (int g = 1; g <= 3; ++g)
-    if (group.has(g) && maps_onto_itself(mesh, f, g, tolerance, &fixed)) forces_passing |= 1u << g;
+    if (group.has(g) && maps_onto_itself(mesh, f, g, tolerance, &fixed) &&
+        stiffness_maps_onto_itself(mesh, k, fixed, g, stiffness_tolerance))
+      forces_passing |= 1u << g;
   // A subgroup of the one the positions allow is symmetric about the
   // positions averaged over the larger one as well.
   return largest_subgroup(forces_passing);

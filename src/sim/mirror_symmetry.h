@@ -66,9 +66,10 @@ inline MirrorGroup mirror_kernel(MirrorGroup group, unsigned odd) { return {grou
 // The largest subgroup under which `state` is symmetric for `model`: the
 // clamped and pinned points and jammed cells map onto themselves, the
 // displacements from the flat grid onto their mirror images within
-// `position_tolerance_m`, and the forces at the symmetrised positions onto
-// theirs within 1e-9 of the largest one plus k h. Cheap (one force
-// evaluation).
+// `position_tolerance_m`, the forces at the symmetrised positions onto
+// theirs within 1e-9 of the largest one plus k h, and the stiffness there
+// onto its mirror image within 1e-9 of its largest entry. One force and
+// one stiffness evaluation.
 MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state,
                                double position_tolerance_m = 1e-9);
 

@@ -47,6 +47,12 @@ enum class SymmetricSettle { kNotTried, kSettled, kFailed };
 SymmetricSettle settle_mirror_symmetric(const ForceModel& model, DeviceState& state, StiffnessMatrix& k,
                                         const std::vector<char>& fixed, const StaticSolverOptions& options,
                                         double mu0, SettleReport& report) {
+  // A start already at equilibrium stays exactly where it is: averaging it
+  // would move it by rounding (a repeated action, a warm replay whose
+  // parameter moves nothing).
+  Eigen::Matrix3Xd f;
+  model.forces(state, state.x, f);
+  if (max_free_force(f, fixed) < options.force_tolerance_n) return SymmetricSettle::kNotTried;
   const MirrorGroup group = mirror_symmetry_of(model, state);
   if (group.trivial()) return SymmetricSettle::kNotTried;
   const Eigen::Matrix3Xd start_x = state.x;
@@ -90,7 +96,6 @@ SettleReport settle_static(const ForceModel& model, DeviceState& state, const St
   // displacements where the state has a mirror symmetry); where it does
   // not settle, the careful one from the same start.
   const bool fast_failed = options.mirror_symmetry && options.fast_iterations > 0 &&
-                           k.num_dofs() >= kMinMirrorDofs &&
                            settle_mirror_symmetric(model, state, k, fixed, options, mu0, report) ==
                                SymmetricSettle::kFailed;
   StepSystem system(k);
