@@ -168,17 +168,20 @@ MirrorGroup mirror_symmetry_of(const ForceModel& model, const DeviceState& state
   // At an equilibrium the largest force is the residual, the difference of
   // spring forces about k h, which round asymmetrically at 1e-16 of that.
   const double tolerance = 1e-9 * (largest + model.params().spring_k * mesh.spacing());
+  unsigned forces_passing = 0;
+  for (int g = 1; g <= 3; ++g)
+    if (group.has(g) && maps_onto_itself(mesh, f, g, tolerance, &fixed)) forces_passing |= 1u << g;
+  if (forces_passing == 0) return {};
   StencilBlocks k(mesh);
   model.add_stiffness(symmetric, symmetric.x, k);
   const double stiffness_tolerance = 1e-9 * k.largest();
-  unsigned forces_passing = 0;
+  unsigned passing_all = 0;
   for (int g = 1; g <= 3; ++g)
-    if (group.has(g) && maps_onto_itself(mesh, f, g, tolerance, &fixed) &&
-        stiffness_maps_onto_itself(mesh, k, fixed, g, stiffness_tolerance))
-      forces_passing |= 1u << g;
+    if ((forces_passing >> g & 1u) && stiffness_maps_onto_itself(mesh, k, fixed, g, stiffness_tolerance))
+      passing_all |= 1u << g;
   // A subgroup of the one the positions allow is symmetric about the
   // positions averaged over the larger one as well.
-  return largest_subgroup(forces_passing);
+  return largest_subgroup(passing_all);
 }
 
 MirrorSubspace::MirrorSubspace(const Mesh& mesh, const StiffnessMatrix& full, MirrorGroup group, unsigned odd)
