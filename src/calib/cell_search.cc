@@ -139,8 +139,7 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
       static_cast<int>(points.size()),
       [&](int k) {
         try {
-          // Warm from the current optimum's replay: a probe changes one cell.
-          const Eigen::VectorXd r = dataset_residuals(dataset, points[k].params, point_replay, nullptr, &current.traces);
+          const Eigen::VectorXd r = dataset_residuals(dataset, points[k].params, point_replay);
           if (r.size() == r0.size()) predict_along_probe(r0_off, r, r0, basis, *points[k].spec, points[k]);
         } catch (const SettleInterrupted&) {
           throw;

@@ -225,7 +225,7 @@ CandidateFit scanned_candidate(const Selection& s, const std::string& effect, do
       c.scan_note = cell.note;
     }
     EffectScan scan = scan_effect_start(s.dataset, start, parameters, effect, s.options.fit.least_squares.replay,
-                                        s.options.scan_options, &s.current.traces);
+                                        s.options.scan_options);
     c.scan_rmse_mm = std::sqrt(scan.best_sum_sq_mm2 / std::max(s.current.residual_count, 1L));
     if (scan.moved) {
       c.scanned_start = std::move(scan.best);

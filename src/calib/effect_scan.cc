@@ -62,8 +62,7 @@ DirectionResult walk(const ModelParams& start, const Direction& d, const EffectS
 
 EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
                              const std::vector<FitParameter>& parameters, const std::string& effect,
-                             const ReplayOptions& replay, const EffectScanOptions& options,
-                             const std::vector<ReplayTrace>* beside) {
+                             const ReplayOptions& replay, const EffectScanOptions& options) {
   EffectScan out;
   out.best = start;
   std::vector<Direction> directions;
@@ -108,7 +107,7 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
   } else {
     std::vector<ReplayTrace> start_traces;
     results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, threads,
-                                                    std::numeric_limits<double>::infinity(), beside, &start_traces);
+                                                    std::numeric_limits<double>::infinity(), nullptr, &start_traces);
     results[0].replays = 1;
     parallel_for(
         static_cast<int>(directions.size()),

@@ -57,13 +57,10 @@ struct EffectScanOptions {
 
 // @param start  the current model's optimum with `effect` switched on at its
 //               start values
-// @param beside  that optimum's traces (one per session, replay.h), or
-//                null: the start's replay moves each step as they did
 // @throws std::runtime_error if the dataset replays neither at `start` nor
 //         at any scanned point
 EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
                              const std::vector<FitParameter>& parameters, const std::string& effect,
-                             const ReplayOptions& replay, const EffectScanOptions& options = {},
-                             const std::vector<ReplayTrace>* beside = nullptr);
+                             const ReplayOptions& replay, const EffectScanOptions& options = {});
 
 }  // namespace hj

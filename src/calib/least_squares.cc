@@ -252,15 +252,14 @@ std::vector<long> capture_rows(const Dataset& dataset) {
 }
 
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                                  std::vector<int>* rows, const std::vector<ReplayTrace>* warm_start) {
+                                  std::vector<int>* rows) {
   std::vector<int> offsets{0};
   for (const auto& s : dataset.sessions) offsets.push_back(offsets.back() + residual_count(s));
   Eigen::VectorXd out(offsets.back());
   parallel_for(
       static_cast<int>(dataset.sessions.size()),
       [&](int s) {
-        out.segment(offsets[s], offsets[s + 1] - offsets[s]) =
-            session_residuals(dataset.sessions[s], params, options, session_trace(warm_start, s));
+        out.segment(offsets[s], offsets[s + 1] - offsets[s]) = session_residuals(dataset.sessions[s], params, options);
       },
       options.threads);
   if (rows) *rows = offsets;

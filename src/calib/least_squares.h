@@ -95,11 +95,9 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
                                      const LeastSquaresProgress& progress = {});
 
 // The residuals of every session stacked in dataset order, and the first
-// row of each (rows.size() == sessions + 1). Sessions run in parallel,
-// each warm from its trace in warm_start if given (replay.h).
+// row of each (rows.size() == sessions + 1). Sessions run in parallel.
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
-                                  std::vector<int>* rows = nullptr,
-                                  const std::vector<ReplayTrace>* warm_start = nullptr);
+                                  std::vector<int>* rows = nullptr);
 
 // The first residual row of each capture, in the order the residuals are
 // laid out (session by session, capture by capture, the measured samples),
