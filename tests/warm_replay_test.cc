@@ -12,8 +12,6 @@
 #include <limits>
 
 #include "calib/dataset.h"
-#include "calib/fit_parameters.h"
-#include "calib/least_squares.h"
 #include "calib/replay_tally.h"
 #include "calib/residuals.h"
 #include "calib/session.h"
@@ -108,35 +106,6 @@ TEST(WarmReplay, TheTallyCountsColdReplaysApart) {
     EXPECT_GT(e.cold_cpu_s, 0.0);
     EXPECT_LT(e.cold_cpu_s, e.cpu_s);
   }
-}
-
-// A fit that starts beside an optimum (a candidate's refit, a short fit of
-// a multi-start) is given the optimum's traces: its first replay is warm
-// too, and it reaches the optimum the cold-started fit reaches.
-TEST(WarmReplay, AFitGivenTheTracesOfAnOptimumBesideItReplaysNothingCold) {
-  const Dataset d = select_sessions(
-      read_dataset(std::filesystem::path(HJ_SHARED_DIR) / "data/sessions/demo-baseline"), {"jammed-sweep", "mixed-1"},
-      true);
-  const auto parameters = fit_parameters({});
-  LeastSquaresOptions options;
-  options.max_iterations = 3;
-  const LeastSquaresResult at_truth = fit_least_squares(d, testing_support::true_tiny_baseline(), parameters, options);
-  ASSERT_EQ(at_truth.traces.size(), 2u);
-  ModelParams beside = at_truth.params;
-  beside.surface.spring_k *= 1.02;
-  beside.surface.mass_kg *= 0.99;
-
-  ReplayTally cold_tally, warm_tally;
-  LeastSquaresOptions cold = options, warm = options;
-  cold.replay.tally = &cold_tally;
-  warm.replay.tally = &warm_tally;
-  warm.start_traces = &at_truth.traces;
-  const LeastSquaresResult from_cold = fit_least_squares(d, beside, parameters, cold);
-  const LeastSquaresResult from_warm = fit_least_squares(d, beside, parameters, warm);
-  for (const ReplayTally::Entry& e : warm_tally.entries()) EXPECT_EQ(e.cold, 0) << e.session;
-  for (const ReplayTally::Entry& e : cold_tally.entries()) EXPECT_EQ(e.cold, 1) << e.session;
-  EXPECT_NEAR(from_warm.rmse_mm, from_cold.rmse_mm, 1e-3);
-  EXPECT_NEAR(from_warm.params.surface.spring_k, from_cold.params.surface.spring_k, 0.01 * from_cold.params.surface.spring_k);
 }
 
 }  // namespace

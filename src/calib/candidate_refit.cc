@@ -60,16 +60,13 @@ void refit_fold_of(Selection& s, const std::vector<FitParameter>& parameters, in
 
 namespace {
 
-// Its first replay moves each step as the current model's did.
-LeastSquaresResult fit_candidate(const Dataset& dataset, const LeastSquaresResult& current, const CandidateFit& c,
+LeastSquaresResult fit_candidate(const Dataset& dataset, const ModelParams& current, const CandidateFit& c,
                                  const std::vector<FitParameter>& parameters, const DiagnoseOptions& options,
                                  const LeastSquaresProgress& progress) {
-  const std::vector<ModelParams> starts = candidate_starts(c, current.params, parameters);
-  LeastSquaresOptions fit = options.fit.least_squares;
-  fit.start_traces = &current.traces;
+  const std::vector<ModelParams> starts = candidate_starts(c, current, parameters);
   for (size_t k = 0;; ++k) {
     try {
-      return fit_least_squares(dataset, starts[k], parameters, fit, progress);
+      return fit_least_squares(dataset, starts[k], parameters, options.fit.least_squares, progress);
     } catch (const SettleInterrupted&) {
       throw;  // the caller stopped the work: not a failed replay
     } catch (const std::exception&) {
@@ -120,7 +117,7 @@ void refit_over_range_if_unexplained(const Selection& s, const std::vector<FitPa
   if (!start) return;
   CandidateFit from_range = c;
   from_range.scanned_start = *start;
-  LeastSquaresResult again = fit_candidate(s.dataset, s.current, from_range, parameters, s.options, progress);
+  LeastSquaresResult again = fit_candidate(s.dataset, s.current.params, from_range, parameters, s.options, progress);
   if (again.sum_sq_mm2 < c.fit.sum_sq_mm2) {
     c.fit = std::move(again);
     c.scanned_start = *start;
@@ -156,9 +153,7 @@ void refit_from_earlier_optimum(const Selection& s, const std::vector<FitParamet
   ModelParams start = with_effects(s.current.params, c.effects);
   start.surface = earlier->second.surface;
   start.effect_parameters[c.added] = earlier->second.effect_parameters.at(c.added);
-  LeastSquaresOptions fit = s.options.fit.least_squares;
-  fit.start_traces = &s.current.traces;
-  LeastSquaresResult again = fit_least_squares(s.dataset, start, parameters, fit,
+  LeastSquaresResult again = fit_least_squares(s.dataset, start, parameters, s.options.fit.least_squares,
                                                least_squares_progress(s.progress, stage + " from its earlier optimum"));
   if (!(again.sum_sq_mm2 < c.fit.sum_sq_mm2)) return;
   char note[200];
@@ -235,7 +230,7 @@ bool refit_locally(Selection& s, CandidateFit& c) {
   const std::string stage = stage_of(s, c);
   try {
     if (s.options.multi_start_before_refit) start_from_best_of_range(s.dataset, s.current.params, s.options, s.progress, c);
-    c.fit = fit_candidate(s.dataset, s.current, c, parameters, s.options, least_squares_progress(s.progress, stage));
+    c.fit = fit_candidate(s.dataset, s.current.params, c, parameters, s.options, least_squares_progress(s.progress, stage));
     judge(s, parameters, c);
   } catch (const SettleInterrupted&) {
     throw;  // the caller stopped the work: not a failed replay
@@ -383,11 +378,9 @@ bool refit_from_rebased_current(Selection& s, CandidateFit& c) {
   ModelParams start = with_effects(s.current.params, c.effects);
   for (const FitParameter& p : parameters)
     if (!p.surface && p.effect == c.added) set_parameter_value(start, p, parameter_value(c.fit.params, p));
-  LeastSquaresOptions fit = s.options.fit.least_squares;
-  fit.start_traces = &s.current.traces;
   try {
     LeastSquaresResult again =
-        fit_least_squares(s.dataset, start, parameters, fit,
+        fit_least_squares(s.dataset, start, parameters, s.options.fit.least_squares,
                           least_squares_progress(s.progress, "candidate " + c.added + " from the refitted current model"));
     if (!(again.sum_sq_mm2 < c.fit.sum_sq_mm2)) return false;
     char note[200];

@@ -159,7 +159,6 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
   // truth; at 2 iterations a 0.6 k cell still lost to a stiff one elsewhere).
   LeastSquaresOptions short_fit = fit;
   short_fit.max_iterations = 4;
-  short_fit.start_traces = &current.traces;
   double best_cost = std::numeric_limits<double>::infinity();
   const size_t refined = ranked.front().predicted < refine_below ? kCellsRefined : 0;
   if (refined == 0) {

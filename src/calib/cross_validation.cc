@@ -73,23 +73,15 @@ CrossValidation cross_validate(const Dataset& dataset, const std::vector<FitPara
     out.heldout_rmse_mm = fit.rmse_mm;
     return out;
   }
-  // Each session's cost at the optimum and its trace, from which the trials
-  // and the held-out replays start (replay_session's warm start): the fit's
-  // own, where it carries the traces its residuals were replayed with;
-  // else replayed here (a screening's prediction has none). Where that
-  // replay fails, every trial passes (the step is taken as it is).
+  // Each session's cost at the optimum, replayed as the trials are: a fit's
+  // own residuals come from warm-started settles (or, for the screening,
+  // from a linearisation). Where that replay fails, every trial passes (the
+  // step is taken as it is). The trials and the held-out replays start from
+  // these replays' moves (replay_session's warm start).
   const bool checked = cv.max_halvings >= 0 && !fit.active.empty();
   std::vector<double> at_optimum(sessions, 0.0);
   std::vector<ReplayTrace> optimum_traces(sessions);
-  const bool fit_traced = static_cast<int>(fit.traces.size()) == sessions &&
-                          static_cast<int>(fit.session_rows.size()) == sessions + 1 &&
-                          fit.residuals.size() == fit.session_rows.back();
-  if (fit_traced) {
-    optimum_traces = fit.traces;
-    for (int s = 0; s < sessions; ++s)
-      at_optimum[s] =
-          fit.residuals.segment(fit.session_rows[s], fit.session_rows[s + 1] - fit.session_rows[s]).squaredNorm();
-  } else if (checked)
+  if (checked)
     parallel_for(
         sessions,
         [&](int s) {

@@ -50,7 +50,6 @@ bool converge(const Dataset& dataset, const std::vector<FitParameter>& parameter
     LeastSquaresOptions longer = options.fit.least_squares;
     longer.max_iterations = more;
     longer.function_tolerance *= 0.1;
-    longer.start_traces = &fit.traces;
     LeastSquaresResult next =
         fit_least_squares(dataset, fit.params, parameters, longer, least_squares_progress(progress, stage));
     if (next.sum_sq_mm2 <= fit.sum_sq_mm2) {  // it starts at the fit's optimum: never worse

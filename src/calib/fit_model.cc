@@ -76,10 +76,8 @@ LeastSquaresResult probe_and_refit(const Dataset& dataset, const std::vector<Fit
     if (progress) progress("probing the optimum", 1, 1, probe.moved ? probe.note : "no better point");
     if (!probe.moved) break;
     const std::string stage = "least squares from the probe";
-    LeastSquaresOptions from_probe = options.least_squares;
-    from_probe.start_traces = &fit.traces;
-    LeastSquaresResult next =
-        fit_least_squares(dataset, probe.best, parameters, from_probe, least_squares_progress(progress, stage));
+    LeastSquaresResult next = fit_least_squares(dataset, probe.best, parameters, options.least_squares,
+                                                least_squares_progress(progress, stage));
     if (!(next.sum_sq_mm2 < fit.sum_sq_mm2)) break;
     char text[320];
     std::snprintf(text, sizeof text, "the least squares %s and was restarted from %s: RMSE %.4f -> %.4f mm",

@@ -3,7 +3,6 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
-#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <atomic>
@@ -37,15 +36,8 @@ class ScaledModel {
 
   ModelParams params_at(const Eigen::VectorXd& u) const {
     ModelParams p = base_;
-    for (int j = 0; j < parameter_count(); ++j) set_parameter_value(p, parameters_[j], value_at(u, j));
+    for (int j = 0; j < parameter_count(); ++j) set_parameter_value(p, parameters_[j], u[j] * scale_[j]);
     return p;
-  }
-
-  // Parameter j's value at u. Ceres keeps u[j] within bound / scale, but
-  // u[j] * scale can round past the bound, and a fit started there refuses it.
-  double value_at(const Eigen::VectorXd& u, int j) const {
-    const ParameterSpec& spec = parameters_[j].spec;
-    return std::clamp(u[j] * scale_[j], spec.lower, spec.upper);
   }
 
   // r(u) (n), and if jacobian, J (n x p); true if every replay succeeded.
@@ -287,7 +279,6 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   // A first Jacobian over all parameters finds those that change nothing.
   ScaledModel probe(dataset, start, parameters, scale, options);
   if (probe.residual_count_all() == 0) throw std::invalid_argument("the dataset has no measured samples");
-  if (options.start_traces) probe.seed_traces(*options.start_traces);
   Eigen::VectorXd r0;
   Eigen::MatrixXd j0;
   if (!probe.evaluate(u0, r0, &j0)) throw std::runtime_error("the model fails to replay the dataset at the start values");
@@ -355,7 +346,6 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   out.evaluations = probe.evaluations() + model.evaluations();
   out.scale = scale_a;
   out.session_rows = model.rows();
-  out.traces = model.traces();
   out.params = model.params_at(u);
   out.sum_sq_mm2 = out.residuals.squaredNorm();
   out.rmse_mm = std::sqrt(out.sum_sq_mm2 / out.residual_count);
@@ -365,7 +355,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   const Eigen::MatrixXd covariance = parameter_covariance(out.jacobian, out.residuals, capture_rows(dataset));
   for (int k = 0; k < p; ++k) {
     ParameterEstimate& e = out.estimates[out.active[k]];
-    e.value = model.value_at(u, k);
+    e.value = u[k] * scale_a[k];
     e.std_error = std::sqrt(std::max(covariance(k, k), 0.0)) * scale_a[k];
     e.ci95_low = e.value - 1.96 * e.std_error;
     e.ci95_high = e.value + 1.96 * e.std_error;

@@ -25,10 +25,6 @@ struct LeastSquaresOptions {
   // reported as only loosely constrained by the data.
   double loose_relative_halfwidth = 0.1;
   ReplayOptions replay = fitting_replay({});
-  // One trace per session (replay.h) of a replay near the start, e.g. the
-  // optimum a candidate starts beside: the first replay at the start moves
-  // each step as that one did rather than settling cold. Not owned.
-  const std::vector<ReplayTrace>* start_traces = nullptr;
 };
 
 struct ParameterEstimate {
@@ -80,9 +76,6 @@ struct LeastSquaresResult {
   Eigen::VectorXd scale;
   std::vector<int> active;  // indices into estimates
   std::vector<int> session_rows;
-  // Each session's settled states at the optimum (replay.h), from the same
-  // replays as `residuals`: later replays beside the optimum start from them.
-  std::vector<ReplayTrace> traces;
 };
 
 // Called after each iteration: iteration, the most there may be, the RMSE.

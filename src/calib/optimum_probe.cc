@@ -42,9 +42,9 @@ OptimumProbe probe_optimum(const Dataset& dataset, const LeastSquaresResult& fit
   // A point above this is never taken, so its replay may stop there.
   const double worth_taking = (1.0 - options.min_gain) * fit.sum_sq_mm2;
   // Each point's replay moves each step as the optimum's replay moved it
-  // (replay_session's warm start): the fit's own traces, or one replay more.
-  std::vector<ReplayTrace> at_optimum = fit.traces;
-  if (out.points > 1 && at_optimum.size() != dataset.sessions.size())
+  // (replay_session's warm start): one replay more, every point cheaper.
+  std::vector<ReplayTrace> at_optimum;
+  if (out.points > 1)
     dataset_sum_of_squares(dataset, fit.params, replay, replay.threads > 0 ? replay.threads : default_thread_count(),
                            std::numeric_limits<double>::infinity(), nullptr, &at_optimum);
   parallel_for(

@@ -42,11 +42,8 @@ std::optional<ModelParams> better_start_than_local(const Dataset& dataset, const
                                                    CandidateFit& c) {
   if (options.multi_start.starts < 1 || !wants_multi_start(c.added)) return std::nullopt;
   if (progress) progress("multi-start " + c.added, 0, 1, "");
-  // Each start's first replay moves each step as the local optimum's did.
-  LeastSquaresOptions fit = options.fit.least_squares;
-  fit.start_traces = &local.traces;
-  const MultiStart range =
-      multi_start(dataset, local.params, fit_parameters(c.effects), c.added, fit, options.multi_start);
+  const MultiStart range = multi_start(dataset, local.params, fit_parameters(c.effects), c.added,
+                                       options.fit.least_squares, options.multi_start);
   c.multi_start_parameter = range.parameter;
   c.starts_tried = range.tried;
   if (progress) progress("multi-start " + c.added, 1, 1, "");
