@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <atomic>
@@ -36,8 +37,15 @@ class ScaledModel {
 
   ModelParams params_at(const Eigen::VectorXd& u) const {
     ModelParams p = base_;
-    for (int j = 0; j < parameter_count(); ++j) set_parameter_value(p, parameters_[j], u[j] * scale_[j]);
+    for (int j = 0; j < parameter_count(); ++j) set_parameter_value(p, parameters_[j], value_at(u, j));
     return p;
+  }
+
+  // Parameter j's value at u. Ceres keeps u[j] within bound / scale, but
+  // u[j] * scale can round past the bound, and a fit started there refuses it.
+  double value_at(const Eigen::VectorXd& u, int j) const {
+    const ParameterSpec& spec = parameters_[j].spec;
+    return std::clamp(u[j] * scale_[j], spec.lower, spec.upper);
   }
 
   // r(u) (n), and if jacobian, J (n x p); true if every replay succeeded.
@@ -355,7 +363,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   const Eigen::MatrixXd covariance = parameter_covariance(out.jacobian, out.residuals, capture_rows(dataset));
   for (int k = 0; k < p; ++k) {
     ParameterEstimate& e = out.estimates[out.active[k]];
-    e.value = u[k] * scale_a[k];
+    e.value = model.value_at(u, k);
     e.std_error = std::sqrt(std::max(covariance(k, k), 0.0)) * scale_a[k];
     e.ci95_low = e.value - 1.96 * e.std_error;
     e.ci95_high = e.value + 1.96 * e.std_error;
