@@ -50,14 +50,13 @@ bool maps_onto_itself(const Mesh& mesh, const Eigen::Matrix3Xd& u, int g, double
 class StencilBlocks final : public StiffnessSink {
  public:
   explicit StencilBlocks(const Mesh& mesh)
-      : mesh_(mesh), blocks_(static_cast<size_t>(mesh.num_points()) * 25, Eigen::Matrix3d::Zero()) {}
+      : nc_(mesh.point_cols()), blocks_(static_cast<size_t>(mesh.num_points()) * 25, Eigen::Matrix3d::Zero()) {}
   void add(int row_point, int col_point, const Eigen::Matrix3d& block) override {
-    if (const int s = slot(row_point, col_point); s >= 0) blocks_[static_cast<size_t>(row_point) * 25 + s] += block;
+    // Row offsets are multiples of nc_, column offsets within -2..2.
+    const int d = col_point - row_point, di = (d + 2 * nc_ + 2) / nc_ - 2, dj = d - di * nc_;
+    if (di >= -2 && di <= 2 && dj >= -2 && dj <= 2) blocks_[slot(row_point, di, dj)] += block;
   }
-  const Eigen::Matrix3d* block(int p, int q) const {
-    const int s = slot(p, q);
-    return s < 0 ? nullptr : &blocks_[static_cast<size_t>(p) * 25 + s];
-  }
+  const Eigen::Matrix3d& block(int p, int di, int dj) const { return blocks_[slot(p, di, dj)]; }
   double largest() const {
     double out = 0.0;
     for (const auto& b : blocks_) out = std::max(out, b.cwiseAbs().maxCoeff());
@@ -65,11 +64,8 @@ class StencilBlocks final : public StiffnessSink {
   }
 
  private:
-  int slot(int p, int q) const {
-    const int di = mesh_.row_of(q) - mesh_.row_of(p), dj = mesh_.col_of(q) - mesh_.col_of(p);
-    return std::abs(di) > 2 || std::abs(dj) > 2 ? -1 : (di + 2) * 5 + (dj + 2);
-  }
-  const Mesh& mesh_;
+  static size_t slot(int p, int di, int dj) { return static_cast<size_t>(p) * 25 + (di + 2) * 5 + (dj + 2); }
+  int nc_;
   std::vector<Eigen::Matrix3d> blocks_;
 };
 
@@ -79,20 +75,27 @@ class StencilBlocks final : public StiffnessSink {
 // so a stiffness gradient leaves the forces symmetric but not K.
 bool stiffness_maps_onto_itself(const Mesh& mesh, const StencilBlocks& k, const std::vector<char>& fixed, int g,
                                 double tolerance) {
-  const Eigen::Matrix3d d = Eigen::Vector3d(flip(g, 0), flip(g, 1), 1.0).asDiagonal();
-  for (int p = 0; p < mesh.num_points(); ++p) {
-    if (fixed[p]) continue;
-    for (int di = -2; di <= 2; ++di)
-      for (int dj = -2; dj <= 2; ++dj) {
-        const int qi = mesh.row_of(p) + di, qj = mesh.col_of(p) + dj;
-        if (qi < 0 || qj < 0 || qi >= mesh.point_rows() || qj >= mesh.point_cols()) continue;
-        const int q = mesh.index(qi, qj);
-        if (fixed[q]) continue;
-        const Eigen::Matrix3d* here = k.block(p, q);
-        const Eigen::Matrix3d* there = k.block(image(mesh, g, p), image(mesh, g, q));
-        if (!here || !there || !((*there - d * *here * d).cwiseAbs().maxCoeff() <= tolerance)) return false;
-      }
-  }
+  // D_g K D_g flips the sign of entry (r, c) by flip(g, r) flip(g, c).
+  const Eigen::Vector3d d(flip(g, 0), flip(g, 1), 1.0);
+  const Eigen::Matrix3d signs = d * d.transpose();
+  const int nr = mesh.point_rows(), nc = mesh.point_cols();
+  // A mirror maps the offset (di, dj) of q from p onto the offset of g q from g p.
+  const int si = (g & 2) ? -1 : 1, sj = (g & 1) ? -1 : 1;
+  for (int i = 0; i < nr; ++i)
+    for (int j = 0; j < nc; ++j) {
+      const int p = mesh.index(i, j);
+      if (fixed[p]) continue;
+      const int gp = image(mesh, g, p);
+      for (int di = -2; di <= 2; ++di)
+        for (int dj = -2; dj <= 2; ++dj) {
+          const int qi = i + di, qj = j + dj;
+          if (std::abs(di) + std::abs(dj) > 2 || qi < 0 || qj < 0 || qi >= nr || qj >= nc) continue;
+          if (fixed[mesh.index(qi, qj)]) continue;
+          const Eigen::Matrix3d& here = k.block(p, di, dj);
+          const Eigen::Matrix3d& there = k.block(gp, si * di, sj * dj);
+          if (!((there - signs.cwiseProduct(here)).cwiseAbs().maxCoeff() <= tolerance)) return false;
+        }
+    }
   return true;
 }
 
