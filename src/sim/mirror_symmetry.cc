@@ -49,11 +49,15 @@ bool maps_onto_itself(const Mesh& mesh, const Eigen::Matrix3Xd& u, int g, double
 // a force model adds them (the same 5 x 5 stencil as StiffnessMatrix).
 class StencilBlocks final : public StiffnessSink {
  public:
-  explicit StencilBlocks(const Mesh& mesh)
-      : nc_(mesh.point_cols()), blocks_(static_cast<size_t>(mesh.num_points()) * 25, Eigen::Matrix3d::Zero()) {}
+  explicit StencilBlocks(const Mesh& mesh) : blocks_(static_cast<size_t>(mesh.num_points()) * 25, Eigen::Matrix3d::Zero()) {
+    // Each point's mesh row and column, so that add() needs no division.
+    for (int p = 0; p < mesh.num_points(); ++p) {
+      row_.push_back(mesh.row_of(p));
+      col_.push_back(mesh.col_of(p));
+    }
+  }
   void add(int row_point, int col_point, const Eigen::Matrix3d& block) override {
-    // Row offsets are multiples of nc_, column offsets within -2..2.
-    const int d = col_point - row_point, di = (d + 2 * nc_ + 2) / nc_ - 2, dj = d - di * nc_;
+    const int di = row_[col_point] - row_[row_point], dj = col_[col_point] - col_[row_point];
     if (di >= -2 && di <= 2 && dj >= -2 && dj <= 2) blocks_[slot(row_point, di, dj)] += block;
   }
   const Eigen::Matrix3d& block(int p, int di, int dj) const { return blocks_[slot(p, di, dj)]; }
@@ -65,7 +69,7 @@ class StencilBlocks final : public StiffnessSink {
 
  private:
   static size_t slot(int p, int di, int dj) { return static_cast<size_t>(p) * 25 + (di + 2) * 5 + (dj + 2); }
-  int nc_;
+  std::vector<int> row_, col_;
   std::vector<Eigen::Matrix3d> blocks_;
 };
 
