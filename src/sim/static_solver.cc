@@ -47,14 +47,15 @@ enum class SymmetricSettle { kNotTried, kSettled, kFailed };
 SymmetricSettle settle_mirror_symmetric(const ForceModel& model, DeviceState& state, StiffnessMatrix& k,
                                         const std::vector<char>& fixed, const StaticSolverOptions& options,
                                         double mu0, SettleReport& report) {
+  const MirrorGroup group = mirror_symmetry_of(model, state);
+  if (group.trivial()) return SymmetricSettle::kNotTried;
   // A start already at equilibrium stays exactly where it is: averaging it
   // would move it by rounding (a repeated action, a warm replay whose
-  // parameter moves nothing).
+  // parameter moves nothing). Asked only of symmetric states, so that an
+  // asymmetric one pays no force evaluation more than the full settle's.
   Eigen::Matrix3Xd f;
   model.forces(state, state.x, f);
   if (max_free_force(f, fixed) < options.force_tolerance_n) return SymmetricSettle::kNotTried;
-  const MirrorGroup group = mirror_symmetry_of(model, state);
-  if (group.trivial()) return SymmetricSettle::kNotTried;
   const Eigen::Matrix3Xd start_x = state.x;
   state.x = mirror_average(model.mesh(), state.x, group, fixed);
   const MirrorSubspace subspace(model.mesh(), k, group);
