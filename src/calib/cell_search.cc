@@ -17,27 +17,34 @@ namespace {
 // How many of the best-predicted cells get a short joint fit.
 constexpr size_t kCellsRefined = 3;
 
-// Halfway from the default to each bound: geometrically where both are
+// How many times a probe that does not replay is retried at half its step.
+constexpr int kProbeHalvings = 2;
+
+// Halfway from the default to `bound`: geometrically where both are
 // positive (a stiffness factor), arithmetically otherwise.
+double halfway(const ParameterSpec& spec, double bound) {
+  return spec.default_value > 0.0 && bound > 0.0 ? std::sqrt(spec.default_value * bound)
+                                                 : 0.5 * (spec.default_value + bound);
+}
+
+// Halfway from the default to each bound.
 std::vector<double> probes(const ParameterSpec& spec) {
   std::vector<double> out;
-  for (double bound : {spec.lower, spec.upper}) {
-    if (bound == spec.default_value) continue;
-    out.push_back(spec.default_value > 0.0 && bound > 0.0 ? std::sqrt(spec.default_value * bound)
-                                                          : 0.5 * (spec.default_value + bound));
-  }
+  for (double bound : {spec.lower, spec.upper})
+    if (bound != spec.default_value) out.push_back(halfway(spec, bound));
   return out;
 }
 
 struct Point {
   int row, col;
-  const ParameterSpec* spec;  // the fitted parameter probed
-  double value;               // its probe
+  const FitParameter* parameter;  // the fitted parameter probed
+  double value;                   // its probe
   ModelParams params;
   // The sum of squares the linear model predicts along this probe's
   // direction, the current parameters re-solved, and the value there.
   double predicted = std::numeric_limits<double>::infinity();
   double predicted_value = 0.0;
+  int replays = 0;
 };
 
 // One cell's score: the lowest sum of squares its probes predict and the
@@ -69,6 +76,27 @@ void predict_along_probe(const Eigen::VectorXd& r0_off, const Eigen::VectorXd& r
   const double t = std::clamp(-dot / nn, 0.0, to_bound / step);
   point.predicted = r0_off.squaredNorm() + 2.0 * t * dot + t * t * nn;
   point.predicted_value = geometric ? spec.default_value * std::exp(t * step) : spec.default_value + t * step;
+}
+
+// Replays the dataset at `point` and predicts along it. Only the probe's
+// direction counts, so one with no equilibrium (a soft cell folding under
+// a baseline that absorbed the defect) is retried at half its step.
+void replay_probe(const Dataset& dataset, const ReplayOptions& replay, const Eigen::VectorXd& r0_off,
+                  const Eigen::VectorXd& r0, const Eigen::MatrixXd& basis, Point& point) {
+  for (int halvings = 0;; ++halvings) {
+    try {
+      ++point.replays;
+      const Eigen::VectorXd r = dataset_residuals(dataset, point.params, replay);
+      if (r.size() == r0.size()) predict_along_probe(r0_off, r, r0, basis, point.parameter->spec, point);
+      return;
+    } catch (const SettleInterrupted&) {
+      throw;
+    } catch (const std::exception&) {
+      if (halvings == kProbeHalvings) return;  // no equilibrium near this probe: it predicts nothing
+    }
+    point.value = halfway(point.parameter->spec, point.value);
+    set_parameter_value(point.params, *point.parameter, point.value);
+  }
 }
 
 // `start` with `effect` in cell (row, col) and its fitted parameters at `value`.
@@ -125,7 +153,7 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
           m.effect_parameters[effect]["row"] = r;
           m.effect_parameters[effect]["col"] = c;
           set_parameter_value(m, p, value);
-          points.push_back({r, c, &p.spec, value, std::move(m)});
+          points.push_back({r, c, &p, value, std::move(m)});
         }
       }
   // A probe is only a start: one only the fallbacks could settle is skipped.
@@ -137,19 +165,10 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
   if (basis.rows() == r0.size()) r0_off -= basis * (basis.transpose() * r0);
   parallel_for(
       static_cast<int>(points.size()),
-      [&](int k) {
-        try {
-          const Eigen::VectorXd r = dataset_residuals(dataset, points[k].params, point_replay);
-          if (r.size() == r0.size()) predict_along_probe(r0_off, r, r0, basis, *points[k].spec, points[k]);
-        } catch (const SettleInterrupted&) {
-          throw;
-        } catch (const std::exception&) {
-          // No equilibrium at this probe: it predicts nothing.
-        }
-      },
+      [&](int k) { replay_probe(dataset, point_replay, r0_off, r0, basis, points[k]); },
       replay.threads);
   CellSearch out;
-  out.replays = static_cast<int>(points.size());
+  for (const Point& p : points) out.replays += p.replays;
   const std::vector<CellScore> ranked = rank_cells(points);
   if (ranked.empty() || !std::isfinite(ranked.front().predicted))
     throw std::runtime_error("the model fails to replay the dataset with " + effect + " in every cell");

@@ -3,7 +3,9 @@
 // between cells. Before its scan, each cell of the array is tried: the
 // dataset is replayed with the effect in that cell at each probe of its
 // fitted parameters (halfway to each bound, geometrically for a positive
-// default: cell_defect's factor 0.45 and 2.24). A probe is scored by the
+// default: cell_defect's factor 0.45 and 2.24; a probe with no equilibrium,
+// such as a soft cell folding under a baseline that absorbed the defect, is
+// retried at half its step, 0.67 then 0.82). A probe is scored by the
 // least-squares prediction along its direction with the current model's
 // parameters re-solved along their Jacobian (the residuals projected off
 // its columns): a baseline fitted to a soft cell has softened every
