@@ -13,6 +13,7 @@
 #include "calib/goodness_of_fit.h"
 #include "calib/like_with_like.h"
 #include "calib/range_start.h"
+#include "calib/redundant_effects.h"
 
 namespace hj {
 
@@ -417,6 +418,7 @@ Diagnosis diagnose(const Dataset& dataset, const ModelParams& start, const Diagn
     out.ladder.push_back({"+ " + best.added, best.fit.rmse_mm, best.heldout_rmse_mm});
     if (leaves_only_noise(s)) break;
   }
+  drop_redundant_effects(s);
   out.verdict = s.chosen;
   out.final_params = s.current.params;
   judge_final_model(dataset, options, s.current, out);
