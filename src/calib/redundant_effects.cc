@@ -32,24 +32,25 @@ void drop_redundant_effects(Selection& s) {
     if (s.progress) s.progress("redundant " + effect, 0, 1, "");
     std::vector<std::string> rest;
     LeastSquaresResult without;
+    bool replays = true;
     try {
       without = replayed_without(s, effect, rest);
     } catch (const SettleInterrupted&) {
       throw;
     } catch (const std::exception&) {
-      ++k;  // the model without it does not replay: it is needed
-      continue;
+      replays = false;  // the model without it has no equilibrium: it is needed
     }
-    if (s.progress) s.progress("redundant " + effect, 1, 1, "");
-    const double delta_bic = bic(without) - bic(s.current);
-    if (delta_bic > 0.0) {
+    const double delta_bic = replays ? bic(without) - bic(s.current) : 0.0;
+    const bool needed = !replays || delta_bic > 0.0;
+    if (s.progress) s.progress("redundant " + effect, 1, 1, needed ? "kept" : "dropped");
+    if (needed) {
       ++k;
       continue;
     }
     char note[400];
     std::snprintf(note, sizeof note,
-                  "%s dropped: with the effects chosen after it, the model without it fits as well (RMSE %.4f -> "
-                  "%.4f mm, delta BIC %.1f for %d fewer parameters)",
+                  "%s dropped: with the effects chosen after it, the model without it is no worse by BIC (RMSE "
+                  "%.4f -> %.4f mm, delta BIC %.1f for %d fewer parameters)",
                   effect.c_str(), s.current.rmse_mm, without.rmse_mm, delta_bic,
                   s.current.free_parameters - without.free_parameters);
     s.out.notes.push_back(note);
