@@ -17,8 +17,9 @@ namespace {
 // How many of the best-predicted cells get a short joint fit.
 constexpr size_t kCellsRefined = 3;
 
-// How many times a probe that does not replay is retried at half its step.
-constexpr int kProbeHalvings = 2;
+// How many times a probe that does not replay is retried at half its step
+// (a replay has no noise, so a twentieth of the step still gives its direction).
+constexpr int kProbeHalvings = 4;
 
 // Halfway from the default to `bound`: geometrically where both are
 // positive (a stiffness factor), arithmetically otherwise.

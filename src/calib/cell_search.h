@@ -5,7 +5,7 @@
 // fitted parameters (halfway to each bound, geometrically for a positive
 // default: cell_defect's factor 0.45 and 2.24; a probe with no equilibrium,
 // such as a soft cell folding under a baseline that absorbed the defect, is
-// retried at half its step, 0.67 then 0.82). A probe is scored by the
+// retried at half its step, down to 0.95 and 1.05). A probe is scored by the
 // least-squares prediction along its direction with the current model's
 // parameters re-solved along their Jacobian (the residuals projected off
 // its columns): a baseline fitted to a soft cell has softened every
