@@ -4,16 +4,11 @@
 #include <cstdio>
 
 #include "calib/fit_parameters.h"
+#include "calib/like_with_like.h"
 
 namespace hj {
 
 namespace {
-
-ModelParams without_effect(ModelParams params, const std::string& effect) {
-  params.effects.erase(std::remove(params.effects.begin(), params.effects.end(), effect), params.effects.end());
-  params.effect_parameters.erase(effect);
-  return params;
-}
 
 // The current model with `effect` off, replayed at the same optimum.
 LeastSquaresResult replayed_without(const Selection& s, const std::string& effect, std::vector<std::string>& rest) {
