@@ -5,6 +5,7 @@
 // of it; where they have none (demo-baseline) it keeps the start.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "calib/effect_scan.h"
@@ -53,6 +54,39 @@ TEST(EffectScan, KeepsTheStartWhereTheDataHaveNoBending) {
   EXPECT_EQ(kappa_bend(scan.best), 0.0);
   EXPECT_EQ(scan.best_sum_sq_mm2, scan.start_sum_sq_mm2);
   EXPECT_TRUE(scan.note.empty());
+}
+
+// Fitted without a stiff jammed cell (kappa_jam 0.11, spring_k 41) the
+// membrane creases at the clamped corners near 2 kPa, and any bending
+// there leaves it without an equilibrium. From that replaying start, a
+// point with no equilibrium counts as a rise: two end the direction.
+TEST(EffectScan, EndsADirectionAfterTwoPointsWithNoEquilibriumFromAStartThatReplays) {
+  const Dataset d = select_sessions(read_dataset(kSessions / "demo-baseline"), {"mixed-3"}, true);
+  ModelParams start = true_baseline();
+  start.surface.spring_k = 41.4;
+  start.surface.kappa_jam = 0.114;
+  ReplayOptions replay = fitting_replay({});
+  replay.threads = 1;
+  const EffectScan scan = scan_effect_start(d, start, fit_parameters({"bending"}), "bending", replay);
+  ASSERT_TRUE(std::isfinite(scan.start_sum_sq_mm2)) << "the start must replay, or this test shows nothing";
+  EXPECT_FALSE(scan.moved) << scan.note;
+  EXPECT_EQ(scan.failed, 2);
+  EXPECT_EQ(scan.replays, 3);  // the start and two points
+}
+
+// area_pressure's default (weight 1) has no equilibrium at 2 kPa: from
+// that start, points with none are stepped over until one replays.
+TEST(EffectScan, StepsOverPointsWithNoEquilibriumFromAStartThatDoesNotReplay) {
+  const Dataset d = select_sessions(read_dataset(kSessions / "demo-baseline"), {"mixed-3"}, true);
+  ModelParams start = with_effects(true_baseline(), {"area_pressure"});
+  ReplayOptions replay = fitting_replay({});
+  replay.threads = 1;
+  const EffectScan scan =
+      scan_effect_start(d, start, fit_parameters({"area_pressure"}), "area_pressure", replay);
+  ASSERT_FALSE(std::isfinite(scan.start_sum_sq_mm2)) << "the start must fail, or this test shows nothing";
+  EXPECT_TRUE(scan.moved) << scan.note;
+  EXPECT_GT(scan.failed, 2);
+  EXPECT_NE(scan.note.find("the start does not replay"), std::string::npos) << scan.note;
 }
 
 // A camera tilt changes no surface: its scan replays the dataset once per

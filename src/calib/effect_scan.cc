@@ -33,8 +33,11 @@ using PointCost = std::function<double(const ModelParams&)>;
 // dataset, or a measurement effect's reused one). A point's replay moves
 // each step as the start's replay moved it (replay_session's warm start),
 // which costs less than a cold replay even 3 x away (docs/calibration.md).
-DirectionResult walk(const ModelParams& start, const Direction& d, const EffectScanOptions& options,
-                     const PointCost& cost) {
+// Two rises in a row end the walk; a point with no equilibrium counts as
+// one once the start or a point has replayed (before that, as from a start
+// with no equilibrium, it is stepped over).
+DirectionResult walk(const ModelParams& start, bool start_replays, const Direction& d,
+                     const EffectScanOptions& options, const PointCost& cost) {
   DirectionResult out;
   int rises = 0;
   for (double fraction : options.fractions) {
@@ -44,7 +47,9 @@ DirectionResult walk(const ModelParams& start, const Direction& d, const EffectS
     const double sum_sq = cost(point);
     ++out.replays;
     if (!std::isfinite(sum_sq)) {
-      ++out.failed;  // no equilibrium here: step over it
+      ++out.failed;
+      const bool replayed_before = start_replays || std::isfinite(out.best_sum_sq);
+      if (replayed_before && ++rises == 2) break;
       continue;
     }
     if (sum_sq < out.best_sum_sq) {
@@ -102,7 +107,8 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
     }
     const CameraFreeReplay& at_points = own ? *own : at_start;
     for (size_t k = 0; k < directions.size(); ++k)
-      results[k + 1] = walk(start, directions[k], options, [&](const ModelParams& p) { return at_points.sum_of_squares(p); });
+      results[k + 1] = walk(start, std::isfinite(results[0].best_sum_sq), directions[k], options,
+                            [&](const ModelParams& p) { return at_points.sum_of_squares(p); });
     for (const auto& r : results) out.failed += r.failed;
   } else {
     std::vector<ReplayTrace> start_traces;
@@ -112,7 +118,8 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
     parallel_for(
         static_cast<int>(directions.size()),
         [&](int k) {
-          results[k + 1] = walk(start, directions[k], options, [&](const ModelParams& p) {
+          results[k + 1] = walk(start, std::isfinite(results[0].best_sum_sq), directions[k], options,
+                                [&](const ModelParams& p) {
             return dataset_sum_of_squares(dataset, p, point_replay, session_threads,
                                           std::numeric_limits<double>::infinity(), &start_traces);
           });
