@@ -99,6 +99,25 @@ TEST(LeastSquares, RecoversTheTrueParametersWithHonestIntervals) {
   EXPECT_GE(cv.heldout_rmse_mm, fit.rmse_mm - 1e-3);
 }
 
+// A fit that is only a start takes no Jacobian where it ends: the same
+// point and cost as the full fit of as many iterations, in fewer replays.
+TEST(LeastSquares, AStartWithoutItsFinalJacobianEndsOnTheSamePointInFewerReplays) {
+  const Dataset d = cheap_sessions();
+  LeastSquaresOptions options;
+  options.max_iterations = 2;
+  options.replay.threads = 1;
+  const LeastSquaresResult full = fit_least_squares(d, off_start(), fit_parameters({}), options);
+  options.final_jacobian = false;
+  const LeastSquaresResult start = fit_least_squares(d, off_start(), fit_parameters({}), options);
+  ASSERT_EQ(full.iterations, 3) << "both steps must be taken, or this test shows nothing";
+  EXPECT_EQ(start.sum_sq_mm2, full.sum_sq_mm2);
+  EXPECT_EQ(model_params_json(start.params), model_params_json(full.params));
+  EXPECT_EQ(start.jacobians, full.jacobians - 1);
+  EXPECT_EQ(start.jacobian.size(), 0);
+  EXPECT_TRUE(std::isnan(estimate(start, "spring_k").std_error));
+  EXPECT_FALSE(start.converged);
+}
+
 TEST(Diagnosis, BicPenalisesParametersAndNoiseFloorIsTheSensors) {
   LeastSquaresResult a;
   a.residual_count = 1000;

@@ -174,9 +174,23 @@ class ScaledModel {
   int evaluations_ = 0;
 };
 
+// The last iteration Ceres has finished (its callbacks run after each), and
+// whether the Jacobian asked for at the fit's last one was left out.
+struct IterationCount : public ceres::IterationCallback {
+  int finished = 0;
+  bool final_jacobian_skipped = false;
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    finished = summary.iteration;
+    return ceres::SOLVER_CONTINUE;
+  }
+};
+
 class DatasetCost : public ceres::CostFunction {
  public:
-  explicit DatasetCost(ScaledModel& model) : model_(model) {
+  // skip_after: with count, the Jacobian Ceres asks for in this iteration
+  // (after its last accepted step) is zeros and costs no replay (0: none).
+  DatasetCost(ScaledModel& model, IterationCount& count, int skip_after)
+      : model_(model), count_(count), skip_after_(skip_after) {
     set_num_residuals(model.residual_count_all());
     mutable_parameter_block_sizes()->push_back(model.parameter_count());
   }
@@ -185,7 +199,14 @@ class DatasetCost : public ceres::CostFunction {
     const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(parameters[0], model_.parameter_count());
     Eigen::VectorXd r;
     Eigen::MatrixXd j;
-    const bool want_j = jacobians && jacobians[0];
+    bool want_j = jacobians && jacobians[0];
+    if (want_j && skip_after_ > 0 && count_.finished + 1 >= skip_after_) {
+      // Asked after the last step: the iteration cap ends the fit before
+      // Ceres could use it (a zero gradient cannot move the point).
+      want_j = false;
+      count_.final_jacobian_skipped = true;
+      Eigen::Map<Eigen::VectorXd>(jacobians[0], num_residuals() * model_.parameter_count()).setZero();
+    }
     // An interruption must not unwind through Ceres: the evaluation fails,
     // the callback ends the solve, and fit_least_squares throws after it.
     try {
@@ -202,6 +223,8 @@ class DatasetCost : public ceres::CostFunction {
 
  private:
   ScaledModel& model_;
+  IterationCount& count_;
+  int skip_after_;
 };
 
 class ProgressCallback : public ceres::IterationCallback {
@@ -314,11 +337,14 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   out.free_parameters = p;
   out.converged = p == 0;  // nothing free: nothing to converge
 
+  IterationCount iteration_count;
   if (p > 0) {
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
     ceres::Problem problem(problem_options);
-    problem.AddResidualBlock(new DatasetCost(model), nullptr, u.data());
+    problem.AddResidualBlock(
+        new DatasetCost(model, iteration_count, options.final_jacobian ? 0 : options.max_iterations), nullptr,
+        u.data());
     for (int k = 0; k < p; ++k) {
       problem.SetParameterLowerBound(u.data(), k, active[k].spec.lower / scale_a[k]);
       problem.SetParameterUpperBound(u.data(), k, active[k].spec.upper / scale_a[k]);
@@ -338,6 +364,7 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
     solver_options.logging_type = ceres::SILENT;
     ProgressCallback callback(progress, options.max_iterations, out.residual_count, options.replay);
     solver_options.callbacks.push_back(&callback);
+    solver_options.callbacks.push_back(&iteration_count);
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     throw_if_interrupted(options.replay);
@@ -345,10 +372,12 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
     out.termination = summary.BriefReport();
     out.converged = summary.termination_type == ceres::CONVERGENCE;
     out.stopped_at_cap = summary.termination_type == ceres::NO_CONVERGENCE;
+    if (iteration_count.final_jacobian_skipped) out.converged = false, out.stopped_at_cap = true;
   }
 
   // The optimum's residuals and Jacobian (cached if Ceres ended on one).
-  if (!model.evaluate(u, out.residuals, &out.jacobian))
+  const bool with_jacobian = options.final_jacobian || p == 0;
+  if (!model.evaluate(u, out.residuals, with_jacobian ? &out.jacobian : nullptr))
     throw std::runtime_error("the model fails to replay the dataset at the fitted values");
   out.jacobians = probe.jacobians() + model.jacobians();
   out.evaluations = probe.evaluations() + model.evaluations();
@@ -360,7 +389,9 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
   const double sst = total_sum_of_squares(dataset);
   out.r2 = sst > 0.0 ? 1.0 - out.sum_sq_mm2 / sst : kNaN;
 
-  const Eigen::MatrixXd covariance = parameter_covariance(out.jacobian, out.residuals, capture_rows(dataset));
+  const Eigen::MatrixXd covariance =
+      with_jacobian ? parameter_covariance(out.jacobian, out.residuals, capture_rows(dataset))
+                    : Eigen::MatrixXd::Constant(p, p, kNaN);
   for (int k = 0; k < p; ++k) {
     ParameterEstimate& e = out.estimates[out.active[k]];
     e.value = model.value_at(u, k);

@@ -25,6 +25,11 @@ struct LeastSquaresOptions {
   // reported as only loosely constrained by the data.
   double loose_relative_halfwidth = 0.1;
   ReplayOptions replay = fitting_replay({});
+  // False for a fit that is only a start (its parameters and cost are
+  // used): no Jacobian is taken at the point it ends on, so the result's
+  // `jacobian` is empty and its estimates' errors NaN. Ceres takes one after
+  // every accepted step, so a 2-iteration fit saves one of its three.
+  bool final_jacobian = true;
 };
 
 struct ParameterEstimate {
