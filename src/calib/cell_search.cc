@@ -179,6 +179,7 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
   // truth; at 2 iterations a 0.6 k cell still lost to a stiff one elsewhere).
   LeastSquaresOptions short_fit = fit;
   short_fit.max_iterations = 4;
+  short_fit.final_jacobian = false;  // a start: only its parameters and cost are used
   double best_cost = std::numeric_limits<double>::infinity();
   const size_t refined = ranked.front().predicted < refine_below ? kCellsRefined : 0;
   if (refined == 0) {

@@ -16,6 +16,7 @@ void start_from_best_of_range(const Dataset& dataset, const ModelParams& current
   // The scan's start on the same footing: its own short fit.
   LeastSquaresOptions short_fit = options.fit.least_squares;
   short_fit.max_iterations = options.multi_start.iterations;
+  short_fit.final_jacobian = false;
   c.multi_start_parameter = range.parameter;
   c.starts_tried = range.tried;
   try {
