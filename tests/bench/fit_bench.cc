@@ -86,6 +86,40 @@ void BM_EffectScanBending(benchmark::State& state) {
 }
 BENCHMARK(BM_EffectScanBending)->Unit(benchmark::kMillisecond);
 
+// The same scan from a baseline that absorbed a stiff edge in soft jammed
+// cells (kappa_jam 0.114, spring_k 41.4): it creases at the clamped
+// corners near 2 kPa, and every bending point of mixed-3 has no
+// equilibrium; the walk ends after two of them.
+void BM_EffectScanBendingCreased(benchmark::State& state) {
+  static const hj::Dataset d = hj::select_sessions(hj::read_dataset(kBaseline), {"mixed-3"}, true);
+  hj::ModelParams start = hj::with_effects(true_params(), {"bending"});
+  start.surface.spring_k = 41.4;
+  start.surface.kappa_jam = 0.114;
+  hj::ReplayOptions replay = hj::fitting_replay({});
+  replay.threads = 1;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(hj::scan_effect_start(d, start, hj::fit_parameters({"bending"}), "bending", replay));
+}
+BENCHMARK(BM_EffectScanBendingCreased)->Unit(benchmark::kMillisecond);
+
+// A multi-start's short fit (2 iterations of the baseline from an off
+// start, unjammed-sweep and mixed-1), with its final Jacobian (Arg 1) and
+// without it (Arg 0, as diagnose's short fits run): the same end point.
+void BM_ShortFit(benchmark::State& state) {
+  static const hj::Dataset d =
+      hj::select_sessions(hj::read_dataset(kBaseline), {"unjammed-sweep", "mixed-1"}, true);
+  hj::ModelParams start = true_params();
+  start.surface.mass_kg = 0.50;
+  start.surface.spring_k = 64.5;
+  hj::LeastSquaresOptions options;
+  options.max_iterations = 2;
+  options.replay.threads = 1;
+  options.replay.fallbacks = false;
+  options.final_jacobian = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(hj::fit_least_squares(d, start, hj::fit_parameters({}), options));
+}
+BENCHMARK(BM_ShortFit)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
 // What a replay costs where the model has no equilibrium, as a fit or a
 // scan meets it: demo-baseline's mixed-2 with kappa_bend 0.001 N m/rad
 // fails at its 3.26 kPa step after the static solver, the implicit flow
