@@ -116,6 +116,14 @@ TEST(LeastSquares, AStartWithoutItsFinalJacobianEndsOnTheSamePointInFewerReplays
   EXPECT_EQ(start.jacobian.size(), 0);
   EXPECT_TRUE(std::isnan(estimate(start, "spring_k").std_error));
   EXPECT_FALSE(start.converged);
+
+  // One iteration still takes its step: only the Jacobian after it is left out.
+  options.max_iterations = 1;
+  const LeastSquaresResult one_step = fit_least_squares(d, off_start(), fit_parameters({}), options);
+  options.final_jacobian = true;
+  const LeastSquaresResult one_full = fit_least_squares(d, off_start(), fit_parameters({}), options);
+  EXPECT_EQ(one_step.sum_sq_mm2, one_full.sum_sq_mm2);
+  EXPECT_NE(estimate(one_step, "spring_k").value, off_start().surface.spring_k);
 }
 
 TEST(Diagnosis, BicPenalisesParametersAndNoiseFloorIsTheSensors) {

@@ -174,10 +174,11 @@ class ScaledModel {
   int evaluations_ = 0;
 };
 
-// The last iteration Ceres has finished (its callbacks run after each), and
-// whether the Jacobian asked for at the fit's last one was left out.
+// The last iteration Ceres has finished (its callbacks run after each, the
+// start's iteration 0 too), and whether the Jacobian asked for at the fit's
+// last one was left out.
 struct IterationCount : public ceres::IterationCallback {
-  int finished = 0;
+  int finished = -1;
   bool final_jacobian_skipped = false;
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
     finished = summary.iteration;
