@@ -90,6 +90,7 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
   ReplayOptions point_replay = replay;
   point_replay.fallbacks = options.fallbacks;
   const int session_threads = std::max(1, threads / std::max(1, static_cast<int>(directions.size())));
+  bool start_replays = false;
   if (options.reuse_measurement_replays && is_measurement_only(effect)) {
     // Every point simulates the same surfaces: the dataset is replayed once
     // with the start's options and once with the points' (they may settle
@@ -98,6 +99,7 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
     start_replay.threads = threads;
     const CameraFreeReplay at_start(dataset, start, start_replay);
     results[0].best_sum_sq = at_start.sum_of_squares(start);
+    start_replays = std::isfinite(results[0].best_sum_sq);
     out.replays = 1;
     std::optional<CameraFreeReplay> own;
     if (point_replay.fallbacks != replay.fallbacks) {
@@ -107,7 +109,7 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
     }
     const CameraFreeReplay& at_points = own ? *own : at_start;
     for (size_t k = 0; k < directions.size(); ++k)
-      results[k + 1] = walk(start, std::isfinite(results[0].best_sum_sq), directions[k], options,
+      results[k + 1] = walk(start, start_replays, directions[k], options,
                             [&](const ModelParams& p) { return at_points.sum_of_squares(p); });
     for (const auto& r : results) out.failed += r.failed;
   } else {
@@ -115,11 +117,11 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
     results[0].best_sum_sq = dataset_sum_of_squares(dataset, start, replay, threads,
                                                     std::numeric_limits<double>::infinity(), nullptr, &start_traces);
     results[0].replays = 1;
+    start_replays = std::isfinite(results[0].best_sum_sq);
     parallel_for(
         static_cast<int>(directions.size()),
         [&](int k) {
-          results[k + 1] = walk(start, std::isfinite(results[0].best_sum_sq), directions[k], options,
-                                [&](const ModelParams& p) {
+          results[k + 1] = walk(start, start_replays, directions[k], options, [&](const ModelParams& p) {
             return dataset_sum_of_squares(dataset, p, point_replay, session_threads,
                                           std::numeric_limits<double>::infinity(), &start_traces);
           });
@@ -131,7 +133,6 @@ EffectScan scan_effect_start(const Dataset& dataset, const ModelParams& start,
     }
   }
   out.start_sum_sq_mm2 = out.best_sum_sq_mm2 = results[0].best_sum_sq;
-  const bool start_replays = std::isfinite(out.start_sum_sq_mm2);
   int best = -1;
   for (size_t k = 1; k < results.size(); ++k)
     if (results[k].best_sum_sq < out.best_sum_sq_mm2) {
