@@ -73,34 +73,33 @@ void BM_LevellingMass(benchmark::State& state) {
 }
 BENCHMARK(BM_LevellingMass)->Unit(benchmark::kMicrosecond);
 
-// diagnose's scan of one candidate (calib/effect_scan.h): bending on
-// mixed-1 at the true baseline, which has none (the start is kept after
-// the walk up stops at two rises).
-void BM_EffectScanBending(benchmark::State& state) {
-  static const hj::Dataset d = hj::select_sessions(hj::read_dataset(kBaseline), {"mixed-1"}, true);
-  const hj::ModelParams start = hj::with_effects(true_params(), {"bending"});
+// diagnose's scan of one candidate (calib/effect_scan.h), bending, from
+// `start` on one session:
+// - true_baseline: mixed-1 at the true baseline, which has none (the start
+//   is kept after the walk up stops at two rises);
+// - creased: mixed-3 from a baseline that absorbed a stiff edge in soft
+//   jammed cells (kappa_jam 0.114, spring_k 41.4). It creases at the
+//   clamped corners near 2 kPa, every bending point has no equilibrium,
+//   and the walk ends after two of them.
+void BM_EffectScanBending(benchmark::State& state, const std::string& session_name, hj::ModelParams start) {
+  const hj::Dataset d = hj::select_sessions(hj::read_dataset(kBaseline), {session_name}, true);
+  start = hj::with_effects(start, {"bending"});
   hj::ReplayOptions replay = hj::fitting_replay({});
   replay.threads = 1;
   for (auto _ : state)
     benchmark::DoNotOptimize(hj::scan_effect_start(d, start, hj::fit_parameters({"bending"}), "bending", replay));
 }
-BENCHMARK(BM_EffectScanBending)->Unit(benchmark::kMillisecond);
 
-// The same scan from a baseline that absorbed a stiff edge in soft jammed
-// cells (kappa_jam 0.114, spring_k 41.4): it creases at the clamped
-// corners near 2 kPa, and every bending point of mixed-3 has no
-// equilibrium; the walk ends after two of them.
-void BM_EffectScanBendingCreased(benchmark::State& state) {
-  static const hj::Dataset d = hj::select_sessions(hj::read_dataset(kBaseline), {"mixed-3"}, true);
-  hj::ModelParams start = hj::with_effects(true_params(), {"bending"});
-  start.surface.spring_k = 41.4;
-  start.surface.kappa_jam = 0.114;
-  hj::ReplayOptions replay = hj::fitting_replay({});
-  replay.threads = 1;
-  for (auto _ : state)
-    benchmark::DoNotOptimize(hj::scan_effect_start(d, start, hj::fit_parameters({"bending"}), "bending", replay));
+hj::ModelParams creased_baseline() {
+  hj::ModelParams p = true_params();
+  p.surface.spring_k = 41.4;
+  p.surface.kappa_jam = 0.114;
+  return p;
 }
-BENCHMARK(BM_EffectScanBendingCreased)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_EffectScanBending, true_baseline, std::string("mixed-1"), true_params())
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_EffectScanBending, creased, std::string("mixed-3"), creased_baseline())
+    ->Unit(benchmark::kMillisecond);
 
 // A multi-start's short fit (2 iterations of the baseline from an off
 // start, unjammed-sweep and mixed-1), with its final Jacobian (Arg 1) and
