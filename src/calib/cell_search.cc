@@ -177,9 +177,7 @@ CellSearch search_cells(const Dataset& dataset, const ModelParams& start, const 
   // iterations: the linearised scores rank cells well but not always the
   // first one right (a baseline that absorbed the defect is far from the
   // truth; at 2 iterations a 0.6 k cell still lost to a stiff one elsewhere).
-  LeastSquaresOptions short_fit = fit;
-  short_fit.max_iterations = 4;
-  short_fit.final_jacobian = false;  // a start: only its parameters and cost are used
+  const LeastSquaresOptions short_fit = start_fit_options(fit, 4);
   double best_cost = std::numeric_limits<double>::infinity();
   const size_t refined = ranked.front().predicted < refine_below ? kCellsRefined : 0;
   if (refined == 0) {

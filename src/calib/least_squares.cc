@@ -275,6 +275,12 @@ std::vector<long> capture_rows(const Dataset& dataset) {
   return rows;
 }
 
+LeastSquaresOptions start_fit_options(LeastSquaresOptions options, int iterations) {
+  options.max_iterations = iterations;
+  options.final_jacobian = false;
+  return options;
+}
+
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,
                                   std::vector<int>* rows) {
   std::vector<int> offsets{0};

@@ -92,6 +92,11 @@ LeastSquaresResult fit_least_squares(const Dataset& dataset, const ModelParams& 
                                      const std::vector<FitParameter>& parameters, const LeastSquaresOptions& options,
                                      const LeastSquaresProgress& progress = {});
 
+// The options of a fit that is only a start for another (a multi-start's or
+// the cell search's short fits): `iterations` iterations and no Jacobian at
+// the end (final_jacobian).
+LeastSquaresOptions start_fit_options(LeastSquaresOptions options, int iterations);
+
 // The residuals of every session stacked in dataset order, and the first
 // row of each (rows.size() == sessions + 1). Sessions run in parallel.
 Eigen::VectorXd dataset_residuals(const Dataset& dataset, const ModelParams& params, const ReplayOptions& options,

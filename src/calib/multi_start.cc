@@ -34,9 +34,7 @@ bool wants_multi_start(const std::string& effect) {
 MultiStart multi_start(const Dataset& dataset, const ModelParams& start, const std::vector<FitParameter>& parameters,
                        const std::string& effect, const LeastSquaresOptions& fit, const MultiStartOptions& options) {
   MultiStart out;
-  LeastSquaresOptions short_fit = fit;
-  short_fit.max_iterations = options.iterations;
-  short_fit.final_jacobian = false;  // a start: only its parameters and cost are used
+  LeastSquaresOptions short_fit = start_fit_options(fit, options.iterations);
   // A start is only a start: one that only the simulator's fallbacks could
   // settle is skipped, as the scan's points are, and fails in a fraction of
   // the time (a failed replay with them cost 20-40 good ones).

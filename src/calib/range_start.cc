@@ -14,9 +14,7 @@ void start_from_best_of_range(const Dataset& dataset, const ModelParams& current
   MultiStart range = multi_start(dataset, scanned, parameters, c.added, options.fit.least_squares,
                                  options.multi_start);
   // The scan's start on the same footing: its own short fit.
-  LeastSquaresOptions short_fit = options.fit.least_squares;
-  short_fit.max_iterations = options.multi_start.iterations;
-  short_fit.final_jacobian = false;
+  const LeastSquaresOptions short_fit = start_fit_options(options.fit.least_squares, options.multi_start.iterations);
   c.multi_start_parameter = range.parameter;
   c.starts_tried = range.tried;
   try {
