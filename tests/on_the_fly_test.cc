@@ -87,6 +87,40 @@ TEST(OnTheFly, AFrameOfAnotherShapeIsRefusedNamingTheRun) {
   }
 }
 
+TEST(OnTheFly, AProbeIsASessionWithACaptureAtRestAndAfterEachPressure) {
+  const std::vector<Action> probe = probe_actions(500.0, 2000.0, 4);
+  ASSERT_EQ(probe.size(), 4u);
+  EXPECT_DOUBLE_EQ(probe.front().pressure_pa, 500.0);
+  EXPECT_DOUBLE_EQ(probe[1].pressure_pa, 1000.0);
+  EXPECT_DOUBLE_EQ(probe.back().pressure_pa, 2000.0);
+  std::vector<RunCapture> captures;
+  for (size_t k = 0; k <= probe.size(); ++k)
+    captures.push_back({k, Eigen::MatrixXd::Constant(grid().ny, grid().nx, double(k))});
+  const MeasuredSession s = captured_session("probe", device(), grid(), probe, captures);
+  ASSERT_EQ(s.captures.size(), 5u);
+  EXPECT_DOUBLE_EQ(s.captures[0].pressure_pa, 0.0);
+  EXPECT_DOUBLE_EQ(s.captures[4].pressure_pa, 2000.0);
+  EXPECT_DOUBLE_EQ(s.captures[3].heights_mm(0, 0), 3.0);
+  EXPECT_EQ(s.captures[2].jammed_count(), 0);
+}
+
+TEST(OnTheFly, ACaptureOutOfOrderOrPastTheActionsIsRefusedNamingTheRun) {
+  const Eigen::MatrixXd frame = Eigen::MatrixXd::Zero(grid().ny, grid().nx);
+  const std::vector<Action> probe = probe_actions(500.0, 1000.0, 2);
+  for (const std::vector<RunCapture>& bad : {std::vector<RunCapture>{{2, frame}, {1, frame}},
+                                             std::vector<RunCapture>{{3, frame}}}) {
+    try {
+      captured_session("probe-2", device(), grid(), probe, bad);
+      ADD_FAILURE() << "accepted a capture after " << bad.back().after_actions << " actions";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("probe-2"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(probe_actions(0.0, 1000.0, 3), std::invalid_argument);
+  EXPECT_THROW(probe_actions(1000.0, 500.0, 3), std::invalid_argument);
+  EXPECT_THROW(probe_actions(500.0, 1000.0, 0), std::invalid_argument);
+}
+
 TEST(OnTheFly, ACandidateThatIsPartOfTheBaselineIsRefused) {
   OnTheFlyOptions options;
   options.candidates = {"springs"};
@@ -110,6 +144,27 @@ TEST(OnTheFly, FindsTheCameraTiltAndTheStiffeningOfTheDevice) {
   EXPECT_LT(fit.rmse_mm, 1.2);
   EXPECT_EQ(fit.captures, 2);
   EXPECT_GT(fit.replays, 0);
+}
+
+// The probe alone (the free membrane at four pressures, no jam or pin)
+// shows the stiffening and the tilt: the dome's height bends with pressure.
+TEST(OnTheFly, FindsTheCameraTiltAndTheStiffeningOfTheDeviceOnAProbe) {
+  const std::vector<Action> probe = probe_actions(470.0, 3000.0, 4);
+  std::vector<RunCapture> captures;
+  for (size_t k = 0; k <= probe.size(); ++k)
+    captures.push_back({k, captured(tilted_stiff_device(), {probe.begin(), probe.begin() + long(k)}, 11 + k)});
+  Dataset dataset;
+  dataset.sessions.push_back(captured_session("probe", device(), grid(), probe, captures));
+  const OnTheFlyFit fit = calibrate_on_the_fly(dataset, baseline(), {});
+  for (const char* effect : {"sensor_tilt", "stiffening"})
+    EXPECT_NE(std::find(fit.added.begin(), fit.added.end(), effect), fit.added.end())
+        << effect << ": " << ::testing::PrintToString(fit.notes);
+  ASSERT_TRUE(fit.params.effect_parameters.count("sensor_tilt"));
+  EXPECT_NEAR(fit.params.effect_parameters.at("sensor_tilt").at("tilt_x_mrad"), 15.0, 1.0);
+  EXPECT_NEAR(fit.params.effect_parameters.at("sensor_tilt").at("tilt_y_mrad"), -10.0, 1.0);
+  EXPECT_LT(fit.rmse_mm, 1.2) << ::testing::PrintToString(fit.notes) << fit.params.surface.spring_k << " beta "
+                              << fit.params.effect_parameters.at("stiffening").at("beta");
+  EXPECT_EQ(fit.captures, 5);
 }
 
 // On a device the baseline describes, nothing is added.

@@ -49,30 +49,84 @@ LeastSquaresResult try_candidate(const Dataset& dataset, const LeastSquaresResul
   return fit(dataset, scan.best, options, options.trial_iterations, replays);
 }
 
+// Every significant candidate added at once, fitted jointly (one fit
+// rather than diagnose's greedy rounds, each of which refits every
+// remaining candidate). It starts from the best trial, whole (its baseline
+// parameters moved with its effect: a stiffening trial softens spring_k),
+// with the other trials' effects added at their values; if it ends worse
+// than that trial, the trial alone is kept.
+LeastSquaresResult joint_fit(const Dataset& dataset, std::vector<LeastSquaresResult>& trials, OnTheFlyFit& out,
+                             const OnTheFlyOptions& options) {
+  const auto best = std::min_element(trials.begin(), trials.end(), [](const auto& a, const auto& b) {
+    return a.rmse_mm < b.rmse_mm;
+  });
+  const std::string best_effect = out.added[size_t(best - trials.begin())];
+  ModelParams joint = best->params;
+  for (size_t k = 0; k < trials.size(); ++k) {
+    if (trials.begin() + long(k) == best) continue;
+    joint = with_effects(joint, {out.added[k]});
+    joint.effect_parameters[out.added[k]] = trials[k].params.effect_parameters.at(out.added[k]);
+  }
+  LeastSquaresResult fitted = fit(dataset, joint, options, options.max_iterations, out.replays);
+  if (fitted.rmse_mm <= best->rmse_mm) return fitted;
+  char text[200];
+  std::snprintf(text, sizeof text, "joint fit: RMSE %.3f mm, above %s's alone (%.3f mm): %s alone kept",
+                fitted.rmse_mm, best_effect.c_str(), best->rmse_mm, best_effect.c_str());
+  out.notes.push_back(text);
+  out.added = {best_effect};
+  return std::move(*best);
+}
+
 }  // namespace
 
-MeasuredSession run_session(const std::string& name, const SessionDevice& device, const SessionGrid& grid,
-                            const std::vector<Action>& actions, const Eigen::MatrixXd& frame_mm) {
-  if (frame_mm.rows() != grid.ny || frame_mm.cols() != grid.nx)
-    throw std::invalid_argument("run " + name + ": a frame of " + std::to_string(frame_mm.rows()) + " x " +
-                                std::to_string(frame_mm.cols()) + " samples for a grid of " +
-                                std::to_string(grid.ny) + " x " + std::to_string(grid.nx));
+MeasuredSession captured_session(const std::string& name, const SessionDevice& device, const SessionGrid& grid,
+                                 const std::vector<Action>& actions, const std::vector<RunCapture>& captures) {
   Session session;
   session.name = name;
   session.device = device;
   session.grid = grid;
-  for (const Action& a : actions) {
+  std::vector<const Eigen::MatrixXd*> frames;
+  size_t done = 0;
+  const auto add_action = [&](const Action& a) {
     SessionStep step;
     step.action = a;
     step.index = static_cast<int>(session.steps.size());
     session.steps.push_back(step);
+  };
+  for (const RunCapture& c : captures) {
+    if (c.frame_mm.rows() != grid.ny || c.frame_mm.cols() != grid.nx)
+      throw std::invalid_argument("run " + name + ": a frame of " + std::to_string(c.frame_mm.rows()) + " x " +
+                                  std::to_string(c.frame_mm.cols()) + " samples for a grid of " +
+                                  std::to_string(grid.ny) + " x " + std::to_string(grid.nx));
+    if (c.after_actions < done || c.after_actions > actions.size())
+      throw std::invalid_argument("run " + name + ": a capture after " + std::to_string(c.after_actions) +
+                                  " actions, out of order or past its " + std::to_string(actions.size()));
+    for (; done < c.after_actions; ++done) add_action(actions[done]);
+    SessionStep capture;
+    capture.kind = SessionStep::Kind::kCapture;
+    capture.frame = captures.size() == 1 ? name : name + " capture " + std::to_string(frames.size() + 1);
+    capture.index = static_cast<int>(session.steps.size());
+    session.steps.push_back(capture);
+    frames.push_back(&c.frame_mm);
   }
-  SessionStep capture;
-  capture.kind = SessionStep::Kind::kCapture;
-  capture.frame = name;
-  capture.index = static_cast<int>(session.steps.size());
-  session.steps.push_back(capture);
-  return measured_session(std::move(session), [&](const Session&, const SessionStep&) { return frame_mm; });
+  return measured_session(std::move(session), [&, next = size_t{0}](const Session&, const SessionStep&) mutable {
+    return *frames.at(next++);
+  });
+}
+
+MeasuredSession run_session(const std::string& name, const SessionDevice& device, const SessionGrid& grid,
+                            const std::vector<Action>& actions, const Eigen::MatrixXd& frame_mm) {
+  return captured_session(name, device, grid, actions, {{actions.size(), frame_mm}});
+}
+
+std::vector<Action> probe_actions(double from_pa, double to_pa, int levels) {
+  if (!(from_pa > 0.0 && from_pa <= to_pa) || levels < 1)
+    throw std::invalid_argument("probe: pressures from " + std::to_string(from_pa) + " to " + std::to_string(to_pa) +
+                                " Pa in " + std::to_string(levels) + " levels; need 0 < from <= to and levels >= 1");
+  std::vector<Action> out;
+  for (int k = 0; k < levels; ++k)
+    out.push_back(Action::set_pressure(levels == 1 ? to_pa : from_pa + (to_pa - from_pa) * k / (levels - 1)));
+  return out;
 }
 
 void OnTheFlyOptions::validate() const {
@@ -109,32 +163,25 @@ OnTheFlyFit calibrate_on_the_fly(const Dataset& dataset, const ModelParams& star
   OnTheFlyFit out;
   LeastSquaresResult current = fit(dataset, start, options, options.max_iterations, out.replays);
   // Each candidate not yet in the model, alone on top of it (a short fit).
-  ModelParams joint = current.params;
-  std::optional<LeastSquaresResult> only;  // the one significant trial, if there is only one
+  std::vector<LeastSquaresResult> significant;  // the trials of out.added, in order
   for (const auto& effect : options.candidates) {
     if (contains(current.params.effects, effect)) continue;
     try {
       LeastSquaresResult trial = try_candidate(dataset, current, effect, options, out.replays);
-      const bool significant = bic(trial) - bic(current) < options.max_delta_bic &&
-                               trial.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm;
-      out.notes.push_back(judged(effect, trial, current, significant));
-      if (!significant) continue;
-      // The trial's values of the effect's own parameters start the joint fit.
-      joint = with_effects(joint, {effect});
-      joint.effect_parameters[effect] = trial.params.effect_parameters.at(effect);
+      const bool passes = bic(trial) - bic(current) < options.max_delta_bic &&
+                          trial.rmse_mm <= (1.0 - options.min_fit_gain) * current.rmse_mm;
+      out.notes.push_back(judged(effect, trial, current, passes));
+      if (!passes) continue;
       out.added.push_back(effect);
-      only = out.added.size() == 1 ? std::optional(std::move(trial)) : std::nullopt;
+      significant.push_back(std::move(trial));
     } catch (const SettleInterrupted&) {
       throw;
     } catch (const std::exception& e) {
       out.notes.push_back(effect + ": not fitted (" + e.what() + ")");
     }
   }
-  // Every significant candidate added at once, fitted jointly (one fit
-  // rather than diagnose's greedy rounds, each of which refits every
-  // remaining candidate).
-  if (out.added.size() > 1) current = fit(dataset, joint, options, options.max_iterations, out.replays);
-  else if (only) current = std::move(*only);
+  if (significant.size() == 1) current = std::move(significant.front());
+  if (significant.size() > 1) current = joint_fit(dataset, significant, out, options);
   for (const auto& e : out.added) out.notes.push_back("added " + e);
   out.params = current.params;
   out.estimates = current.estimates;

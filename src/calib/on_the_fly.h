@@ -17,11 +17,30 @@
 
 namespace hj {
 
-// One run from rest as a session: `actions` in order, then a capture of
-// `frame_mm` ((grid.ny x grid.nx), NaN = not seen).
-// @throws std::invalid_argument if the frame's shape is not the grid's.
+// A frame ((grid.ny x grid.nx) mm, NaN = not seen) and how many of a
+// run's actions came before it.
+struct RunCapture {
+  size_t after_actions = 0;
+  Eigen::MatrixXd frame_mm;
+};
+
+// A run from rest as a session: `actions` in order, each capture after its
+// share of them (in order).
+// @throws std::invalid_argument naming the run if a frame's shape is not
+//         the grid's or the captures are out of order or past the actions.
+MeasuredSession captured_session(const std::string& name, const SessionDevice& device, const SessionGrid& grid,
+                                 const std::vector<Action>& actions, const std::vector<RunCapture>& captures);
+
+// One run from rest: `actions`, then a capture of `frame_mm`.
 MeasuredSession run_session(const std::string& name, const SessionDevice& device, const SessionGrid& grid,
                             const std::vector<Action>& actions, const Eigen::MatrixXd& frame_mm);
+
+// The probe a render fits its device model on (docs/render.md): the free
+// membrane, nothing jammed or pinned, raised from rest through `levels`
+// pressures evenly spaced from `from_pa` to `to_pa`, to be captured at rest
+// and after each.
+// @throws std::invalid_argument unless 0 < from_pa <= to_pa and levels >= 1.
+std::vector<Action> probe_actions(double from_pa, double to_pa, int levels);
 
 struct OnTheFlyOptions {
   // The baseline's parameters that are fitted (SurfaceParameters fields);
