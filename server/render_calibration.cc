@@ -8,24 +8,43 @@ namespace hj::server {
 
 namespace v1 = ::hapticjam::v1;
 
+namespace {
+
+// Pressures of the probe: enough to tell a stiffening (the dome's height
+// against pressure bends) from a softer spring, few enough to be cheap.
+constexpr int kProbeLevels = 4;
+
+}  // namespace
+
 RenderCalibration::RenderCalibration(const ArrayGeometry& geometry, const ModelParams& start, int threads,
                                      std::function<bool()> cancelled)
-    : model_(start) {
+    : geometry_(geometry), model_(start) {
   device_.rows = geometry.rows, device_.cols = geometry.cols;
   device_.cell_size_mm = geometry.cell_size_m * 1000.0;
   device_.max_pressure_kpa = start.surface.max_pressure_pa / 1000.0;
   options_.replay.segments = geometry.segments;  // the planner's mesh: the model it plans with
   options_.replay.threads = threads;
   options_.replay.interrupted = std::move(cancelled);
-  runs_.dir = "render";
 }
 
-void RenderCalibration::add_run_and_fit(int iteration, const std::vector<Action>& actions, const SessionGrid& grid,
-                                        const Eigen::MatrixXd& frame_mm, v1::FittedModel* out) {
-  runs_.sessions.push_back(run_session("iteration-" + std::to_string(iteration), device_, grid, actions, frame_mm));
-  const OnTheFlyFit fit = calibrate_on_the_fly(runs_, model_, options_);
+std::vector<Action> RenderCalibration::probe(double levelling_margin, double plan_top_pa) const {
+  const double from = levelling_margin * model_.surface.levelling_pressure_pa(Mesh(geometry_));
+  const double top = std::min(model_.surface.max_pressure_pa, std::max(plan_top_pa, 2.0 * from));
+  return probe_actions(std::min(from, top), top, kProbeLevels);
+}
+
+void RenderCalibration::fit_probe(const std::vector<Action>& actions, const SessionGrid& grid,
+                                  const std::vector<Eigen::MatrixXd>& frames, v1::FittedModel* out) {
+  std::vector<RunCapture> captures;
+  for (size_t k = 0; k < frames.size(); ++k) captures.push_back({k, frames[k]});
+  Dataset probe;
+  probe.dir = "render";
+  probe.sessions.push_back(captured_session("probe", device_, grid, actions, captures));
+  const OnTheFlyFit fit = calibrate_on_the_fly(probe, model_, options_);
   model_ = fit.params;
+  fitted_ = true;
   fitted_model_to_proto(fit, out);
+  for (size_t k = 0; k + 1 < frames.size(); ++k) out->add_probe_pressures_kpa(actions[k].pressure_pa / 1000.0);
 }
 
 CameraPlane RenderCalibration::camera() const {

@@ -1,7 +1,7 @@
 // The render loop's calibration on the fly (RENDER_CORRECTION_MODEL, BOTH):
-// each iteration's run (its plan from rest and its capture) added to a
-// dataset, the device model refitted on it between iterations by the
-// library (calib/on_the_fly.h), and the result as the proto reports it.
+// a probe of the device (the free membrane raised through a few pressures,
+// captured at rest and at each) as a dataset, the device model fitted on it
+// by the library (calib/on_the_fly.h), and the result as the proto reports it.
 #pragma once
 
 #include <functional>
@@ -23,21 +23,29 @@ class RenderCalibration {
   // The model to plan the next iteration with (the start until a fit).
   const ModelParams& model() const { return model_; }
 
-  // Adds the run to the dataset and refits the model on every run so far.
+  bool fitted() const { return fitted_; }
+
+  // The probe's actions from rest for a plan whose highest pressure is
+  // `plan_top_pa`: from the render's levelling margin up to it.
+  std::vector<Action> probe(double levelling_margin, double plan_top_pa) const;
+
+  // Fits the model on the probe's captures: frames[0] at rest, frames[k]
+  // after actions[k - 1] (a probe the device cut short has fewer).
   // @throws std::invalid_argument, std::runtime_error (a fit that fails),
   //         SettleInterrupted (cancelled).
-  void add_run_and_fit(int iteration, const std::vector<Action>& actions, const SessionGrid& grid,
-                       const Eigen::MatrixXd& frame_mm, hapticjam::v1::FittedModel* out);
+  void fit_probe(const std::vector<Action>& actions, const SessionGrid& grid, const std::vector<Eigen::MatrixXd>& frames,
+                 hapticjam::v1::FittedModel* out);
 
   // The camera the model has found (sensor_tilt, else none), as a plane to
   // take out of the captures.
   CameraPlane camera() const;
 
  private:
+  ArrayGeometry geometry_;
   SessionDevice device_;
   OnTheFlyOptions options_;
-  Dataset runs_;
   ModelParams model_;
+  bool fitted_ = false;
 };
 
 // The fit as reported in the stream.

@@ -100,13 +100,17 @@ class RenderRun {
       }
       const bool last = i == setup_.iterations;
       if (!improved && i > 1) stop = "the error stopped falling (iteration " + std::to_string(i) + ")";
-      const bool stopping = last || (!improved && i > 1);
+      // The model is fitted once and the targets stay the goal: a next plan would repeat this one.
+      const bool repeats = setup_.correction == v1::RENDER_CORRECTION_MODEL && i > 1 && improved && !last;
+      if (repeats) stop = "the fitted model's plan ran (iteration " + std::to_string(i) + "); a next one would repeat it";
+      const bool stopping = last || (!improved && i > 1) || repeats;
       if (stopping) it.set_correction("none: the render ends here");
       emit_iteration(std::move(it));
       if (stopping) break;
     }
     result.set_stop_reason(stop);
-    if (result.best_iteration() > 0 && result.best_iteration() != result.iterations()) leave_at_best(result);
+    if (result.best_iteration() > 0 && (result.best_iteration() != result.iterations() || !device_shows_last_run_))
+      leave_at_best(result);
     if (fits_model(setup_.correction)) *result.mutable_model() = last_model_;
     result.set_seconds(seconds_since(start));
     return result;
@@ -187,15 +191,37 @@ class RenderRun {
   v1::Job run_on_device(int iteration, const std::vector<Action>& steps, const std::string& which) {
     v1::Plan with_capture;
     const std::string name = setup_.name + " iteration " + std::to_string(iteration) + which;
-    v1::Step* rest = with_capture.add_steps();
-    rest->mutable_capture();
-    rest->set_label(name + " at rest");
+    add_capture(name + " at rest", with_capture);
     for (const Action& a : steps) action_to_proto(a, with_capture.add_steps());
-    with_capture.set_planner(setup_.planner);
-    v1::Step* capture = with_capture.add_steps();
+    add_capture(name, with_capture);
+    device_shows_last_run_ = true;
+    return run_job(iteration, name, with_capture);
+  }
+
+  static void add_capture(const std::string& label, v1::Plan& plan) {
+    v1::Step* capture = plan.add_steps();
     capture->mutable_capture();
-    capture->set_label(name);
-    const v1::Job queued = queue_.submit(caller_, name, with_capture);
+    capture->set_label(label);
+  }
+
+  // The probe the model is fitted on: a capture at rest, then each
+  // pressure and a capture. The device is left on the probe's last dome.
+  v1::Job run_probe(int iteration, const std::vector<Action>& probe) {
+    v1::Plan plan;
+    const std::string name = setup_.name + " probe";
+    add_capture(name + " at rest", plan);
+    for (const Action& a : probe) {
+      action_to_proto(a, plan.add_steps());
+      add_capture(name + " at " + a.describe(), plan);
+    }
+    device_shows_last_run_ = false;
+    return run_job(iteration, name, plan);
+  }
+
+  // Submits `plan` as a device job named `name`; waits for it to end.
+  v1::Job run_job(int iteration, const std::string& name, v1::Plan plan) {
+    plan.set_planner(setup_.planner);
+    const v1::Job queued = queue_.submit(caller_, name, plan);
     log_event("render_job", {{"job", queued.id()}, {"iteration", iteration}});
     std::uint64_t seen = 0;
     bool cancel_sent = false;
@@ -301,7 +327,7 @@ class RenderRun {
     *it.mutable_capture() = job.captures(job.captures_size() - 1);
 
     const Eigen::MatrixXd frame = frame_heights(it.capture());
-    if (fits_model(setup_.correction)) fit_model(i, steps, frame, it);
+    if (fits_model(setup_.correction)) fit_model(i, steps, it);
     const Eigen::MatrixXd measured = calibrated(i, frame, it.capture().grid(), it.rest_capture(), it.mutable_camera());
     const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, predicted_state.x, it.capture().grid());
     it.set_point_rows(mesh_.point_rows()), it.set_point_cols(mesh_.point_cols());
@@ -360,23 +386,36 @@ class RenderRun {
     }
   }
 
-  // The device model refitted on every run so far, this one included;
-  // the next iteration plans with it.
-  void fit_model(int i, const std::vector<Action>& steps, const Eigen::MatrixXd& frame, v1::RenderIteration& it) {
-    progress(i, 0.95, "fitting the model on " + std::to_string(i) + " capture" + (i > 1 ? "s" : ""));
+  // After the first run that a next one follows: the device's probe, up to
+  // the plan's highest pressure, and the device model fitted on it; the
+  // next iterations plan with it.
+  void fit_model(int i, const std::vector<Action>& steps, v1::RenderIteration& it) {
+    if (calibration_.fitted() || i == setup_.iterations) return;
+    double plan_top = 0.0;
+    for (const Action& a : steps)
+      if (a.op == Action::Op::kSetPressure) plan_top = std::max(plan_top, a.pressure_pa);
+    const std::vector<Action> probe = calibration_.probe(kDeviceLevellingMargin, plan_top);
+    progress(i, 0.9, "probing the device: " + std::to_string(probe.size()) + " pressures of the free membrane");
+    const v1::Job job = run_probe(i, probe);
+    const bool cut_short = job.state() == v1::JOB_STATE_FAILED && job.captures_size() >= 2;
+    if (job.state() != v1::JOB_STATE_DONE && !cut_short) throw_unfinished(job, "the probe");
+    std::vector<Eigen::MatrixXd> frames;
+    for (const v1::CaptureFrame& c : job.captures()) frames.push_back(frame_heights(c));
+    progress(i, 0.95, "fitting the model on the probe's " + std::to_string(frames.size()) + " captures");
     const auto start = Clock::now();
     try {
-      calibration_.add_run_and_fit(i, steps, session_grid(it.capture().grid()), frame, it.mutable_model());
+      calibration_.fit_probe(probe, session_grid(job.captures(0).grid()), frames, it.mutable_model());
     } catch (const SettleInterrupted&) {
-      throw ServiceError(StatusCode::CANCELLED, "the render was cancelled while fitting iteration " +
-                                                    std::to_string(i) + "'s model");
+      throw ServiceError(StatusCode::CANCELLED, "the render was cancelled while fitting the model");
     } catch (const std::exception& e) {
       throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": the model fit failed: " +
                                                   e.what());
     }
+    it.mutable_model()->set_probe_job_id(job.id());
     it.set_fitting_seconds(seconds_since(start));
     last_model_ = it.model();
-    log_event("render_fit", {{"iteration", i}, {"rmse_mm", it.model().rmse_mm()}, {"seconds", it.fitting_seconds()}});
+    log_event("render_fit", {{"iteration", i}, {"probe_job", job.id()}, {"rmse_mm", it.model().rmse_mm()},
+                             {"seconds", it.fitting_seconds()}});
   }
 
   // A capture (its heights on its grid) at the mesh points, with the
@@ -390,7 +429,7 @@ class RenderRun {
       camera_to_proto({}, "none", out);
       return seen;
     }
-    if (fits_model(setup_.correction)) {
+    if (calibration_.fitted()) {
       const CameraPlane plane = calibration_.camera();
       const bool found = plane.tilt_x_mrad != 0.0 || plane.tilt_y_mrad != 0.0 || plane.offset_mm != 0.0;
       camera_to_proto(plane, found ? "fitted sensor_tilt" : "none", out);
@@ -422,16 +461,16 @@ class RenderRun {
     if (setup_.correction == v1::RENDER_CORRECTION_NONE) return "none (open loop: the same targets again)";
     std::ostringstream s;
     s.precision(3);
-    if (fits_model(setup_.correction)) {
-      s << "plan with the fitted model (RMSE " << it.model().rmse_mm() << " mm on " << it.model().captures()
-        << " capture" << (it.model().captures() > 1 ? "s" : "") << "):";
-      for (const auto& p : it.model().parameters()) s << " " << p.name() << " " << p.value();
+    if (calibration_.fitted()) {
+      s << "plan with the fitted model (RMSE " << last_model_.rmse_mm() << " mm on the probe's "
+        << last_model_.captures() << " captures):";
+      for (const auto& p : last_model_.parameters()) s << " " << p.name() << " " << p.value();
     }
     if (learns_targets(setup_.correction)) {
       const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, outcome, setup_.gain);
       const Eigen::ArrayXXd change = (next - targets_).array().abs();
       targets_ = next;
-      if (fits_model(setup_.correction)) s << "; ";
+      if (calibration_.fitted()) s << "; ";
       s << "targets += " << setup_.gain << " x (goal - "
         << (it.refusal().empty() ? "measured" : "whole plan's prediction moved by the measured misfit")
         << "): mean |change| " << change.mean() << " mm, max "
@@ -456,6 +495,7 @@ class RenderRun {
   std::string screen_stop_;
   RenderCalibration calibration_;
   v1::FittedModel last_model_;
+  bool device_shows_last_run_ = true;  // false after the probe, until a run
 };
 
 }  // namespace

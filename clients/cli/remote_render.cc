@@ -104,6 +104,8 @@ nlohmann::json model_json(const v1::FittedModel& m) {
           {"rmse_mm", m.rmse_mm()},
           {"captures", m.captures()},
           {"replays", m.replays()},
+          {"probe_job_id", m.probe_job_id()},
+          {"probe_pressures_kpa", std::vector<double>(m.probe_pressures_kpa().begin(), m.probe_pressures_kpa().end())},
           {"notes", strings(m.notes())}};
 }
 
