@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <optional>
 #include <stdexcept>
 
 #include "calib/diagnosis.h"
@@ -51,7 +50,8 @@ LeastSquaresResult try_candidate(const Dataset& dataset, const LeastSquaresResul
 
 // Every significant candidate added at once, fitted jointly (one fit
 // rather than diagnose's greedy rounds, each of which refits every
-// remaining candidate). It starts from the best trial, whole (its baseline
+// remaining candidate), to max_iterations: a trial's few iterations stop
+// short of its optimum. It starts from the best trial, whole (its baseline
 // parameters moved with its effect: a stiffening trial softens spring_k),
 // with the other trials' effects added at their values; if it ends worse
 // than that trial, the trial alone is kept.
@@ -180,8 +180,7 @@ OnTheFlyFit calibrate_on_the_fly(const Dataset& dataset, const ModelParams& star
       out.notes.push_back(effect + ": not fitted (" + e.what() + ")");
     }
   }
-  if (significant.size() == 1) current = std::move(significant.front());
-  if (significant.size() > 1) current = joint_fit(dataset, significant, out, options);
+  if (!significant.empty()) current = joint_fit(dataset, significant, out, options);
   for (const auto& e : out.added) out.notes.push_back("added " + e);
   out.params = current.params;
   out.estimates = current.estimates;
