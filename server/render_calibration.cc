@@ -14,6 +14,21 @@ namespace {
 // against pressure bends) from a softer spring, few enough to be cheap.
 constexpr int kProbeLevels = 4;
 
+// The highest pressure at which `plan` jams or pins (its highest pressure if
+// it does neither): past it a plan's pressure only moves its free cells,
+// and a free 6 x 8 dome there (3.45 kPa) is one the planner's model, fitted
+// to a stiffening device, can fail to settle, where the fit's time goes.
+double shaping_pressure_pa(const std::vector<Action>& plan) {
+  double pressure = 0.0, top = 0.0, shaping = 0.0;
+  for (const Action& a : plan) {
+    if (a.op == Action::Op::kSetPressure)
+      pressure = a.pressure_pa, top = std::max(top, pressure);
+    else if (a.op == Action::Op::kJam || a.op == Action::Op::kPin)
+      shaping = std::max(shaping, pressure);
+  }
+  return shaping > 0.0 ? shaping : top;
+}
+
 }  // namespace
 
 RenderCalibration::RenderCalibration(const ArrayGeometry& geometry, const ModelParams& start, int threads,
@@ -25,11 +40,15 @@ RenderCalibration::RenderCalibration(const ArrayGeometry& geometry, const ModelP
   options_.replay.segments = geometry.segments;  // the planner's mesh: the model it plans with
   options_.replay.threads = threads;
   options_.replay.interrupted = std::move(cancelled);
+  // The probe's settles are of the free membrane, which the static solver
+  // settles from the state before; a fit's point where it cannot is a bad
+  // point, and the explicit fallback would spend its steps to learn that.
+  options_.replay.fallbacks = false;
 }
 
-std::vector<Action> RenderCalibration::probe(double levelling_margin, double plan_top_pa) const {
+std::vector<Action> RenderCalibration::probe(double levelling_margin, const std::vector<Action>& plan) const {
   const double from = levelling_margin * model_.surface.levelling_pressure_pa(Mesh(geometry_));
-  const double top = std::min(model_.surface.max_pressure_pa, std::max(plan_top_pa, 2.0 * from));
+  const double top = std::min(model_.surface.max_pressure_pa, std::max(shaping_pressure_pa(plan), 2.0 * from));
   return probe_actions(std::min(from, top), top, kProbeLevels);
 }
 

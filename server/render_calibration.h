@@ -25,9 +25,10 @@ class RenderCalibration {
 
   bool fitted() const { return fitted_; }
 
-  // The probe's actions from rest for a plan whose highest pressure is
-  // `plan_top_pa`: from the render's levelling margin up to it.
-  std::vector<Action> probe(double levelling_margin, double plan_top_pa) const;
+  // The probe's actions from rest after `plan` ran: from the render's
+  // levelling margin up to the highest pressure at which the plan jams or
+  // pins (at least twice the first, at most the array's limit).
+  std::vector<Action> probe(double levelling_margin, const std::vector<Action>& plan) const;
 
   // Fits the model on the probe's captures: frames[0] at rest, frames[k]
   // after actions[k - 1] (a probe the device cut short has fewer).

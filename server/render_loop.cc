@@ -387,14 +387,11 @@ class RenderRun {
   }
 
   // After the first run that a next one follows: the device's probe, up to
-  // the plan's highest pressure, and the device model fitted on it; the
-  // next iterations plan with it.
+  // the pressures that shaped the run, and the device model fitted on it;
+  // the next iterations plan with it.
   void fit_model(int i, const std::vector<Action>& steps, v1::RenderIteration& it) {
     if (calibration_.fitted() || i == setup_.iterations) return;
-    double plan_top = 0.0;
-    for (const Action& a : steps)
-      if (a.op == Action::Op::kSetPressure) plan_top = std::max(plan_top, a.pressure_pa);
-    const std::vector<Action> probe = calibration_.probe(kDeviceLevellingMargin, plan_top);
+    const std::vector<Action> probe = calibration_.probe(kDeviceLevellingMargin, steps);
     progress(i, 0.9, "probing the device: " + std::to_string(probe.size()) + " pressures of the free membrane");
     const v1::Job job = run_probe(i, probe);
     const bool cut_short = job.state() == v1::JOB_STATE_FAILED && job.captures_size() >= 2;
