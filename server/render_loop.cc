@@ -305,7 +305,7 @@ class RenderRun {
     it.set_iteration(i);
     const auto planning_start = Clock::now();
     std::optional<PlanResult> planned = plan(i);
-    if (i > 1 && learns_targets(setup_.correction)) planned = screened(i, std::move(*planned), it);
+    if (targets_moved_) planned = screened(i, std::move(*planned), it);
     it.set_planning_seconds(seconds_since(planning_start));
     if (!planned) return std::nullopt;
 
@@ -463,7 +463,11 @@ class RenderRun {
         << last_model_.captures() << " captures):";
       for (const auto& p : last_model_.parameters()) s << " " << p.name() << " " << p.value();
     }
-    if (learns_targets(setup_.correction)) {
+    // A run planned with the model before this fit: its error is the old
+    // model's, which the fit has corrected, not the next plan's to learn.
+    targets_moved_ = learns_targets(setup_.correction) && !it.has_model();
+    if (learns_targets(setup_.correction) && !targets_moved_) s << "; targets kept (the model was refitted)";
+    if (targets_moved_) {
       const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, outcome, setup_.gain);
       const Eigen::ArrayXXd change = (next - targets_).array().abs();
       targets_ = next;
@@ -493,6 +497,7 @@ class RenderRun {
   RenderCalibration calibration_;
   v1::FittedModel last_model_;
   bool device_shows_last_run_ = true;  // false after the probe, until a run
+  bool targets_moved_ = false;         // by the last correction: the next plan is screened
 };
 
 }  // namespace
