@@ -1,11 +1,12 @@
-// Calibration on the fly (docs/render.md, correction "model"): the runs of a
-// render job, each from rest (a plan's actions, then one capture), form a
-// measurement dataset; the device model is fitted on it, with the optional
-// effects a small selection adds: each candidate is tried alone on top of
-// the current model, and those significant by diagnose's rule (delta BIC and
-// an in-sample gain; not its cross-validation: the first iterations hold
-// only one or two sessions) are added together and fitted jointly. A planner
-// then plans with the fitted model.
+// Calibration on the fly (docs/render.md, correction "model"): captures of
+// one device (a render's probe: the free membrane at a few pressures, or
+// runs from rest, a plan's actions then a capture) form a measurement
+// dataset; the device model is fitted on it, with the optional effects a
+// small selection adds: each candidate is tried alone on top of the current
+// model, and those significant by diagnose's rule (delta BIC and an
+// in-sample gain; not its cross-validation: a probe is one session) are
+// added together and fitted jointly. A planner then plans with the fitted
+// model.
 #pragma once
 
 #include <Eigen/Core>
