@@ -27,8 +27,9 @@ class RenderCalibration {
 
   // The probe's actions from rest after `plan` ran: from the render's
   // levelling margin up to the highest pressure at which the plan jams or
-  // pins (at least twice the first, at most the array's limit).
-  std::vector<Action> probe(double levelling_margin, const std::vector<Action>& plan) const;
+  // pins, or lower, where the model's free dome reaches 1.5 x
+  // `goal_top_mm` (at least twice the first level, at most the array's limit).
+  std::vector<Action> probe(double levelling_margin, const std::vector<Action>& plan, double goal_top_mm) const;
 
   // Fits the model on the probe's captures: frames[0] at rest, frames[k]
   // after actions[k - 1] (a probe the device cut short has fewer).

@@ -391,7 +391,12 @@ class RenderRun {
   // the next iterations plan with it.
   void fit_model(int i, const std::vector<Action>& steps, v1::RenderIteration& it) {
     if (calibration_.fitted() || i == setup_.iterations) return;
-    const std::vector<Action> probe = calibration_.probe(kDeviceLevellingMargin, steps);
+    std::vector<Action> probe;
+    try {
+      probe = calibration_.probe(kDeviceLevellingMargin, steps, setup_.goal_mm.maxCoeff());
+    } catch (const SettleInterrupted&) {
+      throw ServiceError(StatusCode::CANCELLED, "the render was cancelled while choosing the probe's pressures");
+    }
     progress(i, 0.9, "probing the device: " + std::to_string(probe.size()) + " pressures of the free membrane");
     const v1::Job job = run_probe(i, probe);
     const bool cut_short = job.state() == v1::JOB_STATE_FAILED && job.captures_size() >= 2;
