@@ -11,7 +11,7 @@ starts hapticjam-server on it, runs `hapticjam remote render --json` and
 reads the true surface afterwards.
 
   scripts/render_acceptance.py --build build [--sizes 3x4,6x8] [--iterations 5] [--cases stiffening,...]
-                               [--goals ridge,...,PATH] [--corrections targets,model,both] [--planner NAME]
+                               [--goals ridge,...,PATH] [--corrections both,targets,model] [--planner NAME]
                                [--device-segments P]
 
 A goal that is a path (../shared/data/dem/volcano_maunga_whau.csv) is rendered
@@ -260,7 +260,7 @@ def main():
     ap.add_argument("--noise-mm", type=float, default=1.0)
     ap.add_argument("--device-segments", type=int, default=8, help="the emulator's mesh (the planner's is 4)")
     ap.add_argument("--gain", type=float, default=0.0, help="of the target correction (0: the server's default)")
-    ap.add_argument("--corrections", default="targets",
+    ap.add_argument("--corrections", default="both",
                     help="comma-separated: targets, model, both, none (each case runs with each)")
     ap.add_argument("--json-out", help="also write every run's figures here")
     args = ap.parse_args()

@@ -25,7 +25,7 @@ struct RenderSetup {
   Eigen::MatrixXd goal_mm;  // the goal at the mesh points
   std::string planner = kRenderPlanner;
   int iterations = 5;
-  hapticjam::v1::RenderCorrection correction = hapticjam::v1::RENDER_CORRECTION_TARGETS;
+  hapticjam::v1::RenderCorrection correction = hapticjam::v1::RENDER_CORRECTION_BOTH;
   // Above 1: a device seldom moves by all of a target's change (a plan pins
   // and jams at discrete steps), so a gain of 1 converges slowly.
   double gain = 1.5;

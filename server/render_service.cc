@@ -39,8 +39,8 @@ RenderSetup setup_from_proto(const v1::RenderRequest& request, const MapStore& m
                                                          std::to_string(request.gain()));
   if (request.gain() > 0.0) setup.gain = request.gain();
   switch (request.correction()) {
-    case v1::RENDER_CORRECTION_UNSPECIFIED:
-    case v1::RENDER_CORRECTION_TARGETS: setup.correction = v1::RENDER_CORRECTION_TARGETS; break;
+    case v1::RENDER_CORRECTION_UNSPECIFIED: setup.correction = v1::RENDER_CORRECTION_BOTH; break;
+    case v1::RENDER_CORRECTION_TARGETS:
     case v1::RENDER_CORRECTION_NONE:
     case v1::RENDER_CORRECTION_MODEL:
     case v1::RENDER_CORRECTION_BOTH: setup.correction = request.correction(); break;

@@ -85,10 +85,17 @@ TEST(RenderE2e, TheErrorFallsFromTheFirstIterationToTheLastAndTheTrueSurfaceImpr
   for (const char* key : {"iterations", "mae_mm", "rmse_mm", "correlation", "open_loop_mae_mm"})
     EXPECT_TRUE(result.contains(key)) << key << " missing in " << result;
   EXPECT_EQ(first["iteration"], 1);
-  // The first plan is the planner's own; every corrected one was screened.
+  // The default correction: after the first run, the model fitted on the
+  // device's probe; the second plan is the fitted model's for the goal
+  // itself, and every plan after it, of learned targets, was screened.
+  ASSERT_TRUE(first["model"].is_object()) << first;
+  EXPECT_GT(first["model"]["probe_job_id"].get<long>(), first["job_id"].get<long>()) << first;
   EXPECT_TRUE(first["screening"].is_null()) << first;
-  for (std::size_t k = 1; k + 1 < lines.size(); ++k)
+  EXPECT_TRUE(lines[1]["screening"].is_null()) << lines[1];
+  for (std::size_t k = 2; k + 1 < lines.size(); ++k) {
+    ASSERT_TRUE(lines[k]["screening"].is_string()) << lines[k];
     EXPECT_NE(lines[k]["screening"].get<std::string>().find("expected"), std::string::npos) << lines[k];
+  }
   EXPECT_LT(last["mae_mm"].get<double>(), first["mae_mm"].get<double>()) << r.out;
   EXPECT_DOUBLE_EQ(result["open_loop_mae_mm"].get<double>(), first["mae_mm"].get<double>());
   EXPECT_LE(result["mae_mm"].get<double>(), last["mae_mm"].get<double>());

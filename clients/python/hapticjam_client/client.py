@@ -186,13 +186,14 @@ class Client:
 
     # -- rendering --
 
-    def render(self, goal, rows, cols, segments=0, planner="", iterations=0, correction="targets", gain=0.0,
+    def render(self, goal, rows, cols, segments=0, planner="", iterations=0, correction="both", gain=0.0,
                name="", on_event=None, timeout=None):
         """Renders `goal` on the server's device with the loop closed (docs/render.md):
         plan, run, capture, compare with the goal, correct the targets, again.
         on_event(RenderEvent) sees every progress and iteration event.
-        correction: "targets" (learn the targets from the error), "model" (fit the device
-        model on the captures so far and plan with it), "both", or "none" (open loop).
+        correction: "both" (the default: the model, then the targets), "targets" (learn the
+        targets from the error), "model" (probe the device after the first run, fit its model
+        on the probe and plan with it), or "none" (open loop).
         Returns (RenderResult, [RenderIteration, ...])."""
         corrections = {"targets": render_service_pb2.RENDER_CORRECTION_TARGETS,
                        "model": render_service_pb2.RENDER_CORRECTION_MODEL,
