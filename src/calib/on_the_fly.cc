@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <stdexcept>
 
 #include "calib/diagnosis.h"
@@ -85,7 +86,7 @@ MeasuredSession captured_session(const std::string& name, const SessionDevice& d
   session.name = name;
   session.device = device;
   session.grid = grid;
-  std::vector<const Eigen::MatrixXd*> frames;
+  std::map<int, const Eigen::MatrixXd*> frames;  // by step index
   size_t done = 0;
   const auto add_action = [&](const Action& a) {
     SessionStep step;
@@ -107,11 +108,10 @@ MeasuredSession captured_session(const std::string& name, const SessionDevice& d
     capture.frame = captures.size() == 1 ? name : name + " capture " + std::to_string(frames.size() + 1);
     capture.index = static_cast<int>(session.steps.size());
     session.steps.push_back(capture);
-    frames.push_back(&c.frame_mm);
+    frames[capture.index] = &c.frame_mm;
   }
-  return measured_session(std::move(session), [&, next = size_t{0}](const Session&, const SessionStep&) mutable {
-    return *frames.at(next++);
-  });
+  return measured_session(std::move(session),
+                          [&](const Session&, const SessionStep& step) { return *frames.at(step.index); });
 }
 
 MeasuredSession run_session(const std::string& name, const SessionDevice& device, const SessionGrid& grid,
