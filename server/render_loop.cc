@@ -160,6 +160,7 @@ class RenderRun {
     const PlanningModel model = planning_model();
     // The loop measures millimetres: a planner choosing among surfaces chooses by them.
     PlanRequest request{setup_.array.geometry, model.surface, targets_, model.simulator, {}, PlanScoring::kHeightError};
+    request.params.max_pressure_pa = std::min(request.params.max_pressure_pa, pressure_limit_pa_);
     request.levelling_margin = kDeviceLevellingMargin;
     PlanCallbacks callbacks;
     callbacks.cancelled = hooks_.cancelled;
@@ -293,12 +294,21 @@ class RenderRun {
                                v1::RenderIteration& it) {
     it.set_refusal(refused.error());
     it.set_refused_job_id(refused.id());
+    learn_pressure_limit(steps, size_t(actions_done(refused)));
     steps.resize(size_t(actions_done(refused)));
     log_event("render_step_refused", {{"job", refused.id()}, {"iteration", i}, {"step", actions_done(refused)}});
     progress(i, 0.5, "the device refused step " + std::to_string(steps.size()) + "; running the " +
                          std::to_string(steps.size()) + " steps before it");
     predicted = predicted_after(i, steps);
     return run_on_device(i, steps, " (first " + std::to_string(steps.size()) + " steps)");
+  }
+
+  // A pressure the device refused to settle at is past what it can do (a
+  // real array as the emulator, whose settle there did not finish): later
+  // plans stay at or below the pressure it stood at before it.
+  void learn_pressure_limit(const std::vector<Action>& steps, size_t refused) {
+    const double floor = 2.0 * kDeviceLevellingMargin * setup_.array.params.levelling_pressure_pa(mesh_);
+    pressure_limit_pa_ = std::min(pressure_limit_pa_, pressure_limit_after_refusal(steps, refused, floor));
   }
 
   // One run: plan (screened from the second on), run on the device,
@@ -555,6 +565,7 @@ class RenderRun {
   bool device_shows_last_run_ = true;  // false after the probe, until a run
   bool targets_moved_ = false;         // by the last correction: the next plan is screened
   bool misfit_of_this_model_ = true;   // the last run was planned with the model plans are now made with
+  double pressure_limit_pa_ = INFINITY;  // learned from the device's refusals (learn_pressure_limit)
 };
 
 }  // namespace

@@ -1,7 +1,8 @@
 // Screening a closed loop's corrected plan (metrics/correction_screen.h):
 // the expected outcome is the plan's prediction moved by the last run's
 // misfit, a plan expected clearly worse than the best run does not pass, and
-// halving a correction takes the targets halfway back.
+// halving a correction takes the targets halfway back; a refused rise of
+// pressure limits later plans.
 #include "metrics/correction_screen.h"
 
 #include <gtest/gtest.h>
@@ -56,6 +57,23 @@ TEST(CorrectionScreen, BadShapesAndOptionsAreNamed) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("shapes differ, 2 x 2 and 2 x 3"), std::string::npos) << e.what();
   }
+}
+
+const std::vector<Action> kRun = {Action::set_pressure(500), Action::jam(0, 0), Action::set_pressure(1500),
+                                  Action::jam(1, 1), Action::set_pressure(2500), Action::pin(1, 1)};
+
+TEST(PressureLimit, ARefusedRiseOfPressureLimitsLaterPlansToThePressureBeforeIt) {
+  EXPECT_DOUBLE_EQ(pressure_limit_after_refusal(kRun, 4, 900.0), 1500.0);
+}
+
+TEST(PressureLimit, ARefusedJamOrPinOrARefusalNearLevellingTeachesNoLimit) {
+  EXPECT_TRUE(std::isinf(pressure_limit_after_refusal(kRun, 3, 900.0)));  // a jam
+  EXPECT_TRUE(std::isinf(pressure_limit_after_refusal(kRun, 5, 900.0)));  // a pin
+  EXPECT_TRUE(std::isinf(pressure_limit_after_refusal(kRun, 2, 900.0)));  // from 500 Pa, below the floor
+  EXPECT_TRUE(std::isinf(pressure_limit_after_refusal(kRun, 0, 0.0)));    // nothing before it
+  EXPECT_TRUE(std::isinf(pressure_limit_after_refusal(kRun, 9, 0.0)));    // past the run
+  const std::vector<Action> falling = {Action::set_pressure(2000), Action::set_pressure(1200)};
+  EXPECT_TRUE(std::isinf(pressure_limit_after_refusal(falling, 1, 900.0)));  // a fall of pressure
 }
 
 }  // namespace

@@ -32,4 +32,12 @@ bool passes_screen(double expected_mae, double best_mae, const CorrectionScreenO
   return expected_mae <= options.tolerance * best_mae;  // a NaN expectation never passes
 }
 
+double pressure_limit_after_refusal(const std::vector<Action>& steps, size_t refused, double floor_pa) {
+  if (refused >= steps.size() || steps[refused].op != Action::Op::kSetPressure) return INFINITY;
+  double before = 0.0;
+  for (size_t k = 0; k < refused; ++k)
+    if (steps[k].op == Action::Op::kSetPressure) before = steps[k].pressure_pa;
+  return before > 0.0 && before >= floor_pa && before < steps[refused].pressure_pa ? before : INFINITY;
+}
+
 }  // namespace hj

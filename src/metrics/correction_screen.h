@@ -7,6 +7,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
+
+#include "model/action.h"
 
 namespace hj {
 
@@ -31,6 +34,13 @@ Eigen::MatrixXd expected_outcome(const Eigen::MatrixXd& predicted_next_mm, const
 // The targets with the correction since `previous` halved: the midpoint.
 // @throws std::invalid_argument when the shapes differ.
 Eigen::MatrixXd halved_correction(const Eigen::MatrixXd& previous_mm, const Eigen::MatrixXd& corrected_mm);
+
+// After a device refused step `refused` of `steps`: if that step raised the
+// pressure, the pressure the device stood at before it, which later plans
+// should not pass (the refusal says the device cannot settle above it);
+// infinity if the step raised no pressure, or if the pressure before it is
+// below floor_pa (near levelling a plan must still carry the net past its sag).
+double pressure_limit_after_refusal(const std::vector<Action>& steps, size_t refused, double floor_pa);
 
 // True if a plan expected at expected_mae may run after a best of best_mae.
 // @throws std::invalid_argument on a negative or non-finite best, or bad options.
