@@ -174,6 +174,9 @@ export const planPage = {
 
   // URL parameters fill the form (map, rows, cols, segments, planner, region); auto=1 starts the plan.
   async enter(params) {
+    // Until the server's maps and planners are in the form, a plan would be
+    // started from an empty map list ("the server holds no map").
+    if (!running) $('plan-start').disabled = true;
     if (!view) view = await createSurfaceView($('plan-view'));
     $('plan-view').dataset.kind = view.kind;
     try {
@@ -185,6 +188,8 @@ export const planPage = {
       $('plan-file').accept = info.goal_extensions.join(',');
     } catch (error) {
       showError($('plan-error'), error instanceof ApiError ? error : new Error(String(error)));
+    } finally {
+      if (!running) $('plan-start').disabled = false;
     }
     for (const [key, id] of [['map', 'plan-map'], ['rows', 'plan-rows'], ['cols', 'plan-cols'],
                              ['segments', 'plan-segments'], ['planner', 'plan-planner'], ['region', 'plan-region']])

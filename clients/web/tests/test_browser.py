@@ -104,6 +104,9 @@ class BrowserTest(unittest.TestCase):
 
     def plan_volcano(self):
         self.open("plan?map=volcano&rows=3&cols=4&segments=2", TOKENS["operator"])
+        # The start button is enabled once the server's maps are in the form.
+        self.wait(lambda: self.by_id("plan-start").is_enabled() and self.by_id("plan-map").get_attribute("value"),
+                  what="the plan form filled")
         self.by_id("plan-start").click()
         self.wait(lambda: self.by_id("plan-result").is_displayed(), what="the plan's result")
 
