@@ -2,62 +2,12 @@
 
 #include <algorithm>
 
-#include "calib/residuals.h"
+#include "calib/probe.h"
 #include "fitted_parameter_proto.h"
-#include "sim/simulator.h"
-#include "sim/surface_measures.h"
 
 namespace hj::server {
 
 namespace v1 = ::hapticjam::v1;
-
-namespace {
-
-// Pressures of the probe: enough to tell a stiffening (the dome's height
-// against pressure bends) from a softer spring, few enough to be cheap.
-constexpr int kProbeLevels = 4;
-
-// The highest pressure at which `plan` jams or pins (its highest pressure if
-// it does neither): past it a plan's pressure only moves its free cells,
-// and a free 6 x 8 dome there (3.45 kPa) is one the planner's model, fitted
-// to a stiffening device, can fail to settle, where the fit's time goes.
-double shaping_pressure_pa(const std::vector<Action>& plan) {
-  double pressure = 0.0, top = 0.0, shaping = 0.0;
-  for (const Action& a : plan) {
-    if (a.op == Action::Op::kSetPressure)
-      pressure = a.pressure_pa, top = std::max(top, pressure);
-    else if (a.op == Action::Op::kJam || a.op == Action::Op::kPin)
-      shaping = std::max(shaping, pressure);
-  }
-  return shaping > 0.0 ? shaping : top;
-}
-
-// The probe covers the heights the goal asks for, with this margin: a
-// probe far above them (a free 6 x 8 dome at 3 kPa, 150 mm, for a goal of
-// 84 mm) is where the baseline model is furthest off (39 mm RMSE on the
-// stiffening device), every candidate passes against it, and the fit of
-// all of them together is most of the render's fitting time.
-constexpr double kProbeHeightMargin = 1.5;
-
-// The first of `steps` pressures from `from_pa` to `to_pa` at which the free
-// membrane of `model` domes to `height_mm` (to_pa if none does, or if a
-// settle fails).
-double pressure_reaching(const ArrayGeometry& geometry, const ModelParams& model, const ReplayOptions& replay,
-                         double from_pa, double to_pa, double height_mm) {
-  constexpr int kSteps = 8;
-  Simulator simulator(geometry, model.surface, simulator_options(model, replay));
-  try {
-    for (int k = 0; k <= kSteps; ++k) {
-      const double pressure = from_pa + (to_pa - from_pa) * k / kSteps;
-      simulator.apply(Action::set_pressure(pressure));
-      if (point_heights(simulator.mesh(), simulator.state().x).maxCoeff() * 1000.0 >= height_mm) return pressure;
-    }
-  } catch (const NoEquilibrium&) {
-  }
-  return to_pa;
-}
-
-}  // namespace
 
 RenderCalibration::RenderCalibration(const ArrayGeometry& geometry, const ModelParams& start, int threads,
                                      std::function<bool()> cancelled)
@@ -82,12 +32,7 @@ RenderCalibration::RenderCalibration(const ArrayGeometry& geometry, const ModelP
 std::vector<Action> RenderCalibration::probe(double levelling_margin, const std::vector<Action>& plan,
                                              double goal_top_mm) const {
   const double from = levelling_margin * model_.surface.levelling_pressure_pa(Mesh(geometry_));
-  const double limit = model_.surface.max_pressure_pa;
-  const double shaping = std::min(limit, std::max(shaping_pressure_pa(plan), 2.0 * from));
-  const double reach =
-      pressure_reaching(geometry_, model_, options_.replay, from, shaping, kProbeHeightMargin * goal_top_mm);
-  const double top = std::min(shaping, std::max(reach, 2.0 * from));
-  return probe_actions(std::min(from, top), top, kProbeLevels);
+  return probe_for_plan(geometry_, model_, options_.replay, from, plan, goal_top_mm);
 }
 
 void RenderCalibration::fit_probe(const std::vector<Action>& actions, const SessionGrid& grid,

@@ -3,6 +3,7 @@
 // The runs' frames are the model's own (a device with stiffening and a
 // tilted camera, replayed), seen through a 1 mm camera.
 #include "calib/on_the_fly.h"
+#include "calib/probe.h"
 
 #include <gtest/gtest.h>
 

@@ -119,16 +119,6 @@ MeasuredSession run_session(const std::string& name, const SessionDevice& device
   return captured_session(name, device, grid, actions, {{actions.size(), frame_mm}});
 }
 
-std::vector<Action> probe_actions(double from_pa, double to_pa, int levels) {
-  if (!(from_pa > 0.0 && from_pa <= to_pa) || levels < 1)
-    throw std::invalid_argument("probe: pressures from " + std::to_string(from_pa) + " to " + std::to_string(to_pa) +
-                                " Pa in " + std::to_string(levels) + " levels; need 0 < from <= to and levels >= 1");
-  std::vector<Action> out;
-  for (int k = 0; k < levels; ++k)
-    out.push_back(Action::set_pressure(levels == 1 ? to_pa : from_pa + (to_pa - from_pa) * k / (levels - 1)));
-  return out;
-}
-
 void OnTheFlyOptions::validate() const {
   if (max_iterations < 1) throw std::invalid_argument("on-the-fly calibration: max_iterations must be >= 1");
   if (trial_iterations < 1) throw std::invalid_argument("on-the-fly calibration: trial_iterations must be >= 1");

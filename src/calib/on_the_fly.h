@@ -36,13 +36,6 @@ MeasuredSession captured_session(const std::string& name, const SessionDevice& d
 MeasuredSession run_session(const std::string& name, const SessionDevice& device, const SessionGrid& grid,
                             const std::vector<Action>& actions, const Eigen::MatrixXd& frame_mm);
 
-// The probe a render fits its device model on (docs/render.md): the free
-// membrane, nothing jammed or pinned, raised from rest through `levels`
-// pressures evenly spaced from `from_pa` to `to_pa`, to be captured at rest
-// and after each.
-// @throws std::invalid_argument unless 0 < from_pa <= to_pa and levels >= 1.
-std::vector<Action> probe_actions(double from_pa, double to_pa, int levels);
-
 struct OnTheFlyOptions {
   // The baseline's parameters that are fitted (SurfaceParameters fields);
   // the others keep the start's values.

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "calib/on_the_fly.h"
+#include "calib/probe.h"
 #include "calib/replay.h"
 #include "calib/synthesize.h"
 
