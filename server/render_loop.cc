@@ -12,6 +12,8 @@
 #include "plan/planner.h"
 #include "render_calibration.h"
 #include "render_frames.h"
+#include "render_expectation.h"
+#include "render_jobs.h"
 #include "service_error.h"
 #include "sim/settle_report.h"
 #include "sim/simulator.h"
@@ -39,42 +41,18 @@ constexpr double kDeviceLevellingMargin = 1.5;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-// A render job's steps: the capture at rest, the actions, the capture.
-// How many actions it carried out.
-int actions_done(const v1::Job& job) { return std::max(0, job.steps_done() - 1); }
-
-// A job the device failed at one of the plan's actions after carrying out
-// at least one (not at a capture, and not cancelled or interrupted).
-bool refused_part_way(const v1::Job& job, size_t actions) {
-  return job.state() == v1::JOB_STATE_FAILED && actions_done(job) > 0 && size_t(actions_done(job)) < actions;
-}
-
 bool learns_targets(v1::RenderCorrection c) {
   return c == v1::RENDER_CORRECTION_TARGETS || c == v1::RENDER_CORRECTION_BOTH;
 }
 bool fits_model(v1::RenderCorrection c) { return c == v1::RENDER_CORRECTION_MODEL || c == v1::RENDER_CORRECTION_BOTH; }
-
-// The request's model as a fit takes it: its surface and its effects with every value resolved.
-ModelParams model_of(const ArrayConfig& array) {
-  ModelParams out;
-  out.surface = array.params;
-  out.effects = array.simulator.extra_effects;
-  for (const auto& name : out.effects) {
-    const auto given = array.simulator.effect_parameters.find(name);
-    out.effect_parameters[name] = resolve_parameters(
-        EffectRegistry::instance().get(name),
-        given == array.simulator.effect_parameters.end() ? EffectParameterValues{} : given->second);
-  }
-  return out;
-}
-
 
 class RenderRun {
  public:
   RenderRun(const RenderSetup& setup, DeviceQueue& queue, const Caller& caller, const RenderHooks& hooks)
       : setup_(setup), queue_(queue), caller_(caller), hooks_(hooks), mesh_(setup.array.geometry),
         targets_(setup.goal_mm),
-        calibration_(setup.array.geometry, model_of(setup.array), setup.fit_threads, hooks.cancelled) {}
+        calibration_(setup.array.geometry, model_params_of(setup.array.params, setup.array.simulator), setup.fit_threads,
+                     hooks.cancelled) {}
 
   v1::RenderResult run() {
     check_device();
@@ -190,71 +168,37 @@ class RenderRun {
     return simulator.state();
   }
 
-  // Submits one device job: a capture at rest (a job starts vented), the
-  // steps, a capture; waits for it to end.
+  // A run as a device job (a job starts vented); waits for it to end.
   v1::Job run_on_device(int iteration, const std::vector<Action>& steps, const std::string& which) {
-    v1::Plan with_capture;
     const std::string name = setup_.name + " iteration " + std::to_string(iteration) + which;
-    add_capture(name + " at rest", with_capture);
-    for (const Action& a : steps) action_to_proto(a, with_capture.add_steps());
-    add_capture(name, with_capture);
     device_shows_last_run_ = true;
-    return run_job(iteration, name, with_capture);
+    return run_job(iteration, name, run_job_plan(name, steps));
   }
 
-  static void add_capture(const std::string& label, v1::Plan& plan) {
-    v1::Step* capture = plan.add_steps();
-    capture->mutable_capture();
-    capture->set_label(label);
-  }
-
-  // The probe the model is fitted on: a capture at rest, then each
-  // pressure and a capture. The device is left on the probe's last dome.
+  // The probe the model is fitted on. The device is left on its last dome.
   v1::Job run_probe(int iteration, const std::vector<Action>& probe) {
-    v1::Plan plan;
     const std::string name = setup_.name + " probe";
-    add_capture(name + " at rest", plan);
-    for (const Action& a : probe) {
-      action_to_proto(a, plan.add_steps());
-      add_capture(name + " at " + a.describe(), plan);
-    }
     device_shows_last_run_ = false;
-    return run_job(iteration, name, plan);
+    return run_job(iteration, name, probe_job_plan(name, probe));
   }
 
-  // Submits `plan` as a device job named `name`; waits for it to end.
   v1::Job run_job(int iteration, const std::string& name, v1::Plan plan) {
     plan.set_planner(setup_.planner);
-    const v1::Job queued = queue_.submit(caller_, name, plan);
-    log_event("render_job", {{"job", queued.id()}, {"iteration", iteration}});
-    std::uint64_t seen = 0;
-    bool cancel_sent = false;
-    for (;;) {
-      v1::Job job = queue_.get(queued.id());
-      if (is_finished(job.state())) return job;
-      if (!cancel_sent && hooks_.cancelled()) {
-        cancel_sent = true;
-        try {
-          queue_.cancel(caller_, queued.id());
-        } catch (const ServiceError&) {
-          // It ended meanwhile: the next get() says how.
-        }
-      }
+    RenderJobHooks hooks;
+    hooks.queued = [&](const v1::Job& job) {
+      log_event("render_job", {{"job", job.id()}, {"iteration", iteration}});
+    };
+    hooks.cancelled = hooks_.cancelled;
+    hooks.progress = [&](const v1::Job& job) {
       progress(iteration, 0.5 + 0.5 * job.steps_done() / std::max(1, job.steps_total()),
                "on the device: step " + std::to_string(job.steps_done()) + " of " + std::to_string(job.steps_total()) +
                    (job.position() > 0 ? " (position " + std::to_string(job.position()) + " in the queue)" : ""));
-      seen = queue_.wait_for_change(seen, std::chrono::milliseconds(200));
-      if (queue_.stopping()) throw ServiceError(StatusCode::UNAVAILABLE, "the server is shutting down");
-    }
+    };
+    return run_device_job(queue_, caller_, name, plan, hooks);
   }
 
-  // A device job that did not end with its captures ends the render:
-  // CANCELLED if the caller cancelled it, else ABORTED, naming the job and how it ended.
   [[noreturn]] void throw_unfinished(const v1::Job& job, const std::string& what) const {
-    const bool cancelled = job.state() == v1::JOB_STATE_CANCELLED && hooks_.cancelled();
-    throw ServiceError(cancelled ? StatusCode::CANCELLED : StatusCode::ABORTED,
-                       what + ": device job " + std::to_string(job.id()) + " ended " + v1::JobState_Name(job.state()) +
-                           (job.error().empty() ? std::string() : ": " + job.error()));
+    server::throw_unfinished(job, what, hooks_.cancelled());
   }
 
   // The device holds what it ran last; a render ends with it showing the
@@ -323,10 +267,10 @@ class RenderRun {
     } else if (i > 1 && learns_targets(setup_.correction)) {
       // The first plan of a refitted model: nothing to screen against yet,
       // but its prediction can correct its targets.
-      double expected = expected_mae(i, *planned);
+      RenderExpectation::Expected expected = expected_of(i, *planned);
       std::ostringstream s;
       s.precision(3);
-      s << "the refitted model's plan, predicted " << expected << " mm";
+      s << "the refitted model's plan, predicted " << expected.mae_mm << " mm";
       refined_in_model(i, *planned, expected, s);
       it.set_screening(s.str());
     }
@@ -364,8 +308,8 @@ class RenderRun {
     } catch (const std::invalid_argument& e) {
       throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": " + e.what());
     }
-    previous_targets_ = targets_, last_measured_ = measured, last_predicted_ = predicted;
-    last_grid_ = it.capture().grid();
+    previous_targets_ = targets_;
+    expectation_.after_run(measured, predicted, it.capture().grid());
     it.set_correction(correct(whole_plan_outcome(measured, predicted, *planned, it), it));
     return it;
   }
@@ -379,9 +323,9 @@ class RenderRun {
     std::ostringstream s;
     s.precision(3);
     for (int halvings = 0;; ++halvings) {
-      double expected = expected_mae(i, planned);
-      s << (halvings ? ", then " : "expected ") << expected << " mm";
-      if (passes_screen(expected, best_mae_, options)) {
+      RenderExpectation::Expected expected = expected_of(i, planned);
+      s << (halvings ? ", then " : "expected ") << expected.mae_mm << " mm";
+      if (passes_screen(expected.mae_mm, best_mae_, options)) {
         s << " against the best run's " << best_mae_ << " mm: run";
         if (halvings) s << ", the correction halved " << halvings << (halvings > 1 ? " times" : " time");
         refined_in_model(i, planned, expected, s);
@@ -406,40 +350,25 @@ class RenderRun {
   // (kModelCorrections at most). A step costs a plan, not a run on the
   // device; with a fitted model, the expectations of the first fitted
   // plans at 6 x 8 came within 0.15 mm of their runs.
-  void refined_in_model(int i, PlanResult& planned, double& expected, std::ostringstream& s) {
+  void refined_in_model(int i, PlanResult& planned, RenderExpectation::Expected& expected, std::ostringstream& s) {
     for (int k = 0; k < kModelCorrections; ++k) {
       const Eigen::MatrixXd kept = targets_;
-      targets_ = learned_targets(targets_, setup_.goal_mm, expected_surface(i, planned), 1.0);
+      targets_ = learned_targets(targets_, setup_.goal_mm, expected.surface, 1.0);
       progress(i, 0.0, "correcting the plan in the model");
       PlanResult again = plan(i);
-      const double e = expected_mae(i, again);
-      if (!(e < expected * (1.0 - kMinImprovement))) {
+      RenderExpectation::Expected e = expected_of(i, again);
+      if (!(e.mae_mm < expected.mae_mm * (1.0 - kMinImprovement))) {
         targets_ = kept;
         return;
       }
-      s << "; corrected in the model: expected " << e << " mm";
-      planned = std::move(again), expected = e;
+      s << "; corrected in the model: expected " << e.mae_mm << " mm";
+      planned = std::move(again), expected = std::move(e);
     }
   }
 
-  // What the device is expected to make of `planned`, at the mesh points:
-  // its prediction moved by the last run's misfit, if that run was planned
-  // with the same model (a refit corrected the old model's misfit).
-  Eigen::MatrixXd expected_surface(int i, const PlanResult& planned) const {
-    const Eigen::MatrixXd predicted = predicted_at_rest_points(mesh_, planned.final_state.x, last_grid_);
-    if (!misfit_of_this_model_) return predicted;
+  RenderExpectation::Expected expected_of(int i, const PlanResult& planned) const {
     try {
-      return expected_outcome(predicted, last_measured_, last_predicted_);
-    } catch (const std::invalid_argument& e) {
-      throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": screening its plan: " +
-                                                  e.what());
-    }
-  }
-
-  // The goal against what the device is expected to make of `planned`.
-  double expected_mae(int i, const PlanResult& planned) const {
-    try {
-      return height_error(setup_.goal_mm, expected_surface(i, planned)).mae_mm;
+      return expectation_.of(planned);
     } catch (const std::invalid_argument& e) {
       throw ServiceError(StatusCode::ABORTED, "render iteration " + std::to_string(i) + ": screening its plan: " +
                                                   e.what());
@@ -531,7 +460,7 @@ class RenderRun {
     // A run planned with the model before this fit: its error is the old
     // model's, which the fit has corrected, not the next plan's to learn.
     targets_moved_ = learns_targets(setup_.correction) && !it.has_model();
-    misfit_of_this_model_ = !it.has_model();
+    if (it.has_model()) expectation_.model_refitted();
     if (learns_targets(setup_.correction) && !targets_moved_) s << "; targets kept (the model was refitted)";
     if (targets_moved_) {
       const Eigen::MatrixXd next = learned_targets(targets_, setup_.goal_mm, outcome, setup_.gain);
@@ -552,19 +481,18 @@ class RenderRun {
   const RenderHooks& hooks_;
   const Mesh mesh_;
   Eigen::MatrixXd targets_;
-  // The best MAE against the goal so far; the last run's targets, and its
-  // capture and prediction at the mesh points, for screening the next plan.
+  // The best MAE against the goal so far; the last run's targets, to halve
+  // a correction back towards; what the device is expected to make of a plan.
   double best_mae_ = INFINITY;
-  Eigen::MatrixXd previous_targets_, last_measured_, last_predicted_;
+  Eigen::MatrixXd previous_targets_;
+  RenderExpectation expectation_{mesh_, setup_.goal_mm};
   // The steps the device ran in the last iteration and in the best one.
   std::vector<Action> last_steps_, best_steps_;
-  v1::CaptureGrid last_grid_;
   std::string screen_stop_;
   RenderCalibration calibration_;
   v1::FittedModel last_model_;
   bool device_shows_last_run_ = true;  // false after the probe, until a run
   bool targets_moved_ = false;         // by the last correction: the next plan is screened
-  bool misfit_of_this_model_ = true;   // the last run was planned with the model plans are now made with
   double pressure_limit_pa_ = INFINITY;  // learned from the device's refusals (learn_pressure_limit)
 };
 

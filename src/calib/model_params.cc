@@ -89,6 +89,19 @@ ModelParams parse_model_params(const nlohmann::json& doc, const SurfaceParameter
   return out;
 }
 
+ModelParams model_params_of(const SurfaceParameters& surface, const SimulatorOptions& options) {
+  ModelParams out;
+  out.surface = surface;
+  out.effects = options.extra_effects;
+  for (const auto& name : out.effects) {
+    const auto given = options.effect_parameters.find(name);
+    out.effect_parameters[name] = resolve_parameters(
+        EffectRegistry::instance().get(name),
+        given == options.effect_parameters.end() ? EffectParameterValues{} : given->second);
+  }
+  return out;
+}
+
 ModelParams read_model_params(const std::filesystem::path& path, const SurfaceParameters& defaults) {
   std::ifstream in(path);
   if (!in) throw ParamsError(path.string() + ": cannot open the params file");

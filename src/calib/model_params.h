@@ -39,6 +39,10 @@ struct ModelParams {
   void apply_to(SimulatorOptions& options) const;
 };
 
+// The reverse of apply_to: `surface` with the effects `options` switches
+// on, every parameter value resolved (missing = the effect's default).
+ModelParams model_params_of(const SurfaceParameters& surface, const SimulatorOptions& options);
+
 // The SurfaceParameters field named `name` (mass_kg, spring_k, damping_b,
 // kappa_jam, gravity, max_pressure_pa), or nullptr for another name.
 double* surface_field(SurfaceParameters& surface, const std::string& name);
